@@ -1,0 +1,78 @@
+//! Broad phase: two dynamic AABB trees (static shapes; kinematic and dynamic shapes) of fat
+//! boxes, and pair finding for the proxies that moved.
+//!
+//! Incremental: only shapes whose box left its fat box are re-inserted and queried, so a
+//! step costs O(m log n) for m moved shapes among n. Pairs live as contacts until their
+//! fat boxes stop overlapping (checked in the narrow phase).
+
+use super::tree::DynamicTree;
+use crate::math::Aabb;
+use std::collections::HashMap;
+
+/// Which tree a proxy lives in.
+pub(crate) const STATIC_TREE: u8 = 0;
+/// Tree of kinematic and dynamic shapes.
+pub(crate) const MOVING_TREE: u8 = 1;
+
+/// Extra room [m] added around a shape's box when it is (re)inserted, so small motions
+/// do not touch the tree (Box2D v3 uses 0.05–0.1 m).
+pub(crate) const AABB_MARGIN: f32 = 0.1;
+
+/// The broad phase.
+#[derive(Default)]
+pub(crate) struct BroadPhase {
+    pub trees: [DynamicTree; 2],
+    /// Shape indices whose proxies moved (or were created) since the last pair update.
+    pub moved: Vec<u32>,
+    /// Existing pairs: pair key → contact index. Used for lookups only, never iterated,
+    /// so hash order cannot leak into the simulation.
+    pub pairs: HashMap<u64, u32, BuildPairHasher>,
+}
+
+impl BroadPhase {
+    /// Inserts a proxy for a shape; returns its proxy id.
+    pub fn create_proxy(&mut self, tree: u8, aabb: Aabb, category: u64, shape_index: u32) -> u32 {
+        self.moved.push(shape_index);
+        self.trees[tree as usize].create_proxy(aabb, category, shape_index as u64)
+    }
+
+    /// Removes a proxy.
+    pub fn destroy_proxy(&mut self, tree: u8, proxy: u32) {
+        self.trees[tree as usize].destroy_proxy(proxy);
+    }
+
+    /// Moves a proxy to a new fat box and marks its shape as moved.
+    pub fn move_proxy(&mut self, tree: u8, proxy: u32, aabb: Aabb, shape_index: u32) {
+        self.trees[tree as usize].move_proxy(proxy, aabb);
+        self.moved.push(shape_index);
+    }
+}
+
+/// A small, fast, deterministic hasher for pair keys (a multiplicative hash: the keys are
+/// already well-spread integers, so SipHash's DoS resistance buys nothing here).
+#[derive(Default, Clone, Copy)]
+pub(crate) struct BuildPairHasher;
+
+impl std::hash::BuildHasher for BuildPairHasher {
+    type Hasher = PairHasher;
+    fn build_hasher(&self) -> PairHasher {
+        PairHasher(0)
+    }
+}
+
+/// See [`BuildPairHasher`].
+pub(crate) struct PairHasher(u64);
+
+impl std::hash::Hasher for PairHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0.rotate_left(5) ^ b as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        }
+    }
+    fn write_u64(&mut self, k: u64) {
+        self.0 = (k ^ (k >> 29)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    }
+}

@@ -1,0 +1,419 @@
+//! Polygon–polygon contact (also used for polygon–capsule and polygon–segment, with the
+//! capsule or segment as a 2-vertex polygon).
+//!
+//! Method (separating-axis theorem + reference-face clipping):
+//! 1. For each edge normal of A, the separation of B is `min_j n·(b_j − a_i)`; the largest over
+//!    A's edges is `sep_a` (likewise `sep_b`). For convex polygons the larger of the two is the
+//!    core separation when the closest features are a vertex and an edge, and a lower bound on
+//!    the core distance otherwise, so `max > spec + r_a + r_b` means no contact.
+//! 2. The reference face is A's best edge unless B's is better by more than
+//!    `0.1 · LINEAR_SLOP` (so a box resting on a box does not swap faces from step to step).
+//!    The incident edge is the edge of the other polygon whose normal is most anti-parallel to
+//!    the reference normal.
+//! 3. If the cores are apart (`max(sep) > 0.1 · LINEAR_SLOP`) and the closest points of the
+//!    reference and incident edges are a vertex of each, the contact is that vertex pair
+//!    (normal along the vertex–vertex direction, separation = distance − radii); this gives
+//!    sane speculative contacts near corners and the exact rounded-corner contact.
+//! 4. Otherwise the incident edge is clipped to the reference edge's side planes and each end
+//!    closer than `spec` becomes a point (see `clip_incident_edge`). If the incident edge lies
+//!    wholly outside the side planes (possible only for 2-vertex polygons), the closest points
+//!    of the two edges give one point instead.
+
+use super::{
+    clip_incident_edge, feature_id, segment_closest, LocalManifold, Manifold, CORE_TOUCH, KIND_CLIP_REF_A,
+    KIND_CLIP_REF_B, KIND_VERTEX_VERTEX,
+};
+use crate::geometry::{Polygon, LINEAR_SLOP, MAX_POLYGON_VERTICES};
+use crate::math::{Transform, Vec2};
+
+/// A polygon (or 2-vertex "polygon" for a capsule/segment) expressed in A's frame.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct LocalPoly {
+    pub v: [Vec2; MAX_POLYGON_VERTICES],
+    pub n: [Vec2; MAX_POLYGON_VERTICES],
+    pub count: usize,
+    pub radius: f32,
+}
+
+impl LocalPoly {
+    /// `p` moved by `xf`.
+    pub fn from_polygon(p: &Polygon, xf: Transform) -> LocalPoly {
+        let mut out = LocalPoly {
+            v: [Vec2::ZERO; MAX_POLYGON_VERTICES],
+            n: [Vec2::ZERO; MAX_POLYGON_VERTICES],
+            count: p.count(),
+            radius: p.radius(),
+        };
+        for (i, (v, n)) in p.vertices().iter().zip(p.normals()).enumerate() {
+            out.v[i] = xf.apply(*v);
+            out.n[i] = xf.q.rotate(*n);
+        }
+        out
+    }
+
+    /// The segment `p1`–`p2` (already in the target frame) grown by `radius`: vertices
+    /// `[p1, p2]`, edge 0 is `p1 → p2` with normal `right_perp`, edge 1 is `p2 → p1`.
+    pub fn from_segment(p1: Vec2, p2: Vec2, radius: f32) -> LocalPoly {
+        let n = (p2 - p1).right_perp().try_normalize().unwrap_or(Vec2::Y);
+        let mut out = LocalPoly {
+            v: [Vec2::ZERO; MAX_POLYGON_VERTICES],
+            n: [Vec2::ZERO; MAX_POLYGON_VERTICES],
+            count: 2,
+            radius,
+        };
+        out.v[0] = p1;
+        out.v[1] = p2;
+        out.n[0] = n;
+        out.n[1] = -n;
+        out
+    }
+}
+
+/// Edge of `p1` with the largest separation of `p2` from it, and that separation [m].
+fn max_separation(p1: &LocalPoly, p2: &LocalPoly) -> (usize, f32) {
+    let mut best_edge = 0;
+    let mut best = f32::MIN;
+    for i in 0..p1.count {
+        let n = p1.n[i];
+        let v = p1.v[i];
+        let mut si = f32::MAX;
+        for j in 0..p2.count {
+            si = si.min(n.dot(p2.v[j] - v));
+        }
+        if si > best {
+            best = si;
+            best_edge = i;
+        }
+    }
+    (best_edge, best)
+}
+
+/// Polygon A against polygon B, both in A's frame. See the module documentation.
+pub(super) fn collide_polygons_local(a: &LocalPoly, b: &LocalPoly, spec: f32) -> LocalManifold {
+    let empty = LocalManifold::default();
+    if a.count < 2 || b.count < 2 || a.count > MAX_POLYGON_VERTICES || b.count > MAX_POLYGON_VERTICES {
+        return empty;
+    }
+    let radius = a.radius + b.radius;
+    let (edge_a, sep_a) = max_separation(a, b);
+    let (edge_b, sep_b) = max_separation(b, a);
+    if !(sep_a <= spec + radius && sep_b <= spec + radius) {
+        return empty;
+    }
+
+    let flip = sep_b > sep_a + 0.1 * LINEAR_SLOP;
+    let (rf, inc, ref_edge) = if flip { (b, a, edge_b) } else { (a, b, edge_a) };
+    let n = rf.n[ref_edge];
+
+    let mut inc_edge = 0;
+    let mut min_dot = f32::MAX;
+    for j in 0..inc.count {
+        let d = n.dot(inc.n[j]);
+        if d < min_dot {
+            min_dot = d;
+            inc_edge = j;
+        }
+    }
+
+    let i11 = ref_edge;
+    let i12 = (ref_edge + 1) % rf.count;
+    let i21 = inc_edge;
+    let i22 = (inc_edge + 1) % inc.count;
+    let (v11, v12) = (rf.v[i11], rf.v[i12]);
+    let (v21, v22) = (inc.v[i21], inc.v[i22]);
+
+    // Normal from A to B given a direction from the reference towards the incident polygon.
+    let a_to_b = |d: Vec2| if flip { -d } else { d };
+    // Id of a pair (reference vertex or edge index, incident vertex index).
+    let pair_id = |kind_ref_a: u16, kind_ref_b: u16, ref_feature: usize, inc_vertex: usize| {
+        if flip {
+            feature_id(kind_ref_b, inc_vertex, ref_feature)
+        } else {
+            feature_id(kind_ref_a, ref_feature, inc_vertex)
+        }
+    };
+
+    let closest_fallback = |only_vertices: bool| -> Option<LocalManifold> {
+        let c = segment_closest(v11, v12, v21, v22);
+        let at_vertex = |f: f32| f == 0.0 || f == 1.0;
+        if only_vertices && !(at_vertex(c.fa) && at_vertex(c.fb)) {
+            return None;
+        }
+        let delta = c.b - c.a;
+        let dist = delta.length();
+        let (dir, core_sep) = if dist > CORE_TOUCH {
+            (delta * (1.0 / dist), dist)
+        } else {
+            (n, n.dot(delta))
+        };
+        let mut m = LocalManifold::new(a_to_b(dir));
+        let separation = core_sep - radius;
+        // Reference surface at c.a + r_ref·dir, incident surface at c.b − r_inc·dir.
+        let point = (c.a + dir * rf.radius + c.b - dir * inc.radius) * 0.5;
+        let rv = if c.fa < 0.5 { i11 } else { i12 };
+        let iv = if c.fb < 0.5 { i21 } else { i22 };
+        let id = pair_id(KIND_VERTEX_VERTEX, KIND_VERTEX_VERTEX, rv, iv);
+        m.push(point, separation, id, spec);
+        Some(m)
+    };
+
+    if sep_a.max(sep_b) > CORE_TOUCH {
+        if let Some(m) = closest_fallback(true) {
+            return m;
+        }
+    }
+
+    match clip_incident_edge(v11, v12, n, rf.radius, v21, v22, i21, i22, inc.radius, spec) {
+        Some((points, count)) => {
+            let mut m = LocalManifold::new(a_to_b(n));
+            for p in &points[..count] {
+                let id = pair_id(KIND_CLIP_REF_A, KIND_CLIP_REF_B, ref_edge, p.incident_vertex);
+                m.push(p.point, p.separation, id, spec);
+            }
+            m
+        }
+        None => closest_fallback(false).unwrap_or(empty),
+    }
+}
+
+/// Contact between polygons `a` (placed by `xf_a`) and `b` (placed by `xf_b`).
+pub(super) fn collide_polygons(a: &Polygon, xf_a: Transform, b: &Polygon, xf_b: Transform, spec: f32) -> Manifold {
+    let la = LocalPoly::from_polygon(a, Transform::IDENTITY);
+    let lb = LocalPoly::from_polygon(b, xf_a.inv_mul(xf_b));
+    collide_polygons_local(&la, &lb, spec).to_world(xf_a, xf_b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_support::*;
+    use super::super::{collide, Manifold};
+    use crate::geometry::{Polygon, Shape, SPECULATIVE_DISTANCE};
+    use crate::math::{Transform, Vec2};
+
+    const SPEC: f32 = SPECULATIVE_DISTANCE;
+
+    fn boxed(hx: f32, hy: f32) -> Shape {
+        Shape::Polygon(Polygon::new_box(hx, hy).unwrap())
+    }
+
+    fn xf(x: f32, y: f32, a: f32) -> Transform {
+        Transform::new(Vec2::new(x, y), a)
+    }
+
+    fn xs(m: &Manifold) -> Vec<f32> {
+        let mut v: Vec<f32> = m.active_points().iter().map(|p| p.point.x).collect();
+        v.sort_by(f32::total_cmp);
+        v
+    }
+
+    #[test]
+    fn unit_box_on_ground_box() {
+        let ground = boxed(50.0, 1.0);
+        let b = boxed(0.5, 0.5);
+        let m = collide(&ground, xf(0.0, 0.0, 0.0), &b, xf(3.0, 1.5, 0.0), SPEC);
+        assert_eq!(m.count, 2);
+        assert_near_v(m.normal, Vec2::new(0.0, 1.0), 1e-6);
+        let x = xs(&m);
+        assert!((x[0] - 2.5).abs() < 1e-5 && (x[1] - 3.5).abs() < 1e-5, "{x:?}");
+        for p in m.active_points() {
+            assert!(p.separation.abs() < 1e-5);
+            assert!((p.point.y - 1.0).abs() < 1e-5);
+        }
+        check_manifold(&m, xf(0.0, 0.0, 0.0), xf(3.0, 1.5, 0.0));
+        // Same thing with the box as A: normal points down.
+        let m = collide(&b, xf(3.0, 1.5, 0.0), &ground, xf(0.0, 0.0, 0.0), SPEC);
+        assert_eq!(m.count, 2);
+        assert_near_v(m.normal, Vec2::new(0.0, -1.0), 1e-6);
+        let x = xs(&m);
+        assert!((x[0] - 2.5).abs() < 1e-5 && (x[1] - 3.5).abs() < 1e-5, "{x:?}");
+    }
+
+    #[test]
+    fn box_on_box_overlap_and_speculative() {
+        let a = boxed(0.5, 0.5);
+        // 1 cm overlap.
+        let m = collide(&a, xf(0.0, 0.0, 0.0), &a, xf(0.2, 0.99, 0.0), SPEC);
+        assert_eq!(m.count, 2);
+        for p in m.active_points() {
+            assert!((p.separation + 0.01).abs() < 1e-5);
+            // Midway between the surfaces y = 0.5 and y = 0.49.
+            assert!((p.point.y - 0.495).abs() < 1e-5);
+        }
+        assert_eq!(xs(&m).len(), 2);
+        let x = xs(&m);
+        assert!((x[0] + 0.3).abs() < 1e-5 && (x[1] - 0.5).abs() < 1e-5, "{x:?}");
+        // 1 cm gap: speculative points with positive separation.
+        let m = collide(&a, xf(0.0, 0.0, 0.0), &a, xf(0.2, 1.01, 0.0), SPEC);
+        assert_eq!(m.count, 2);
+        for p in m.active_points() {
+            assert!((p.separation - 0.01).abs() < 1e-5);
+        }
+        // Beyond the speculative distance: nothing.
+        let m = collide(&a, xf(0.0, 0.0, 0.0), &a, xf(0.2, 1.0 + 1.5 * SPEC, 0.0), SPEC);
+        assert_eq!(m.count, 0);
+        // A larger speculative distance keeps them.
+        let m = collide(&a, xf(0.0, 0.0, 0.0), &a, xf(0.2, 1.0 + 1.5 * SPEC, 0.0), 2.0 * SPEC);
+        assert_eq!(m.count, 2);
+    }
+
+    #[test]
+    fn rotated_configuration() {
+        // Both bodies rotated by the same angle: the contact rotates with them.
+        let ground = boxed(5.0, 0.5);
+        let b = boxed(0.5, 0.5);
+        let ang = 0.6f32;
+        let xa = xf(1.0, -2.0, ang);
+        let q = xa.q;
+        let xb = Transform {
+            p: xa.p + q.rotate(Vec2::new(1.0, 1.0 - 0.002)),
+            q,
+        };
+        let m = collide(&ground, xa, &b, xb, SPEC);
+        assert_eq!(m.count, 2);
+        assert_near_v(m.normal, q.rotate(Vec2::new(0.0, 1.0)), 1e-5);
+        for p in m.active_points() {
+            assert!((p.separation + 0.002).abs() < 1e-4);
+            let local = xa.inv_apply(p.point);
+            assert!((local.y - 0.499).abs() < 1e-4, "{local:?}");
+            assert!(
+                (local.x - 0.5).abs() < 1e-4 || (local.x - 1.5).abs() < 1e-4,
+                "{local:?}"
+            );
+        }
+        check_manifold(&m, xa, xb);
+    }
+
+    #[test]
+    fn box_on_its_corner() {
+        let ground = boxed(50.0, 1.0);
+        let b = boxed(0.5, 0.5);
+        let h = 0.5 * 2.0f32.sqrt();
+        let xb = xf(0.3, 1.0 + h - 0.001, core::f32::consts::FRAC_PI_4);
+        let m = collide(&ground, xf(0.0, 0.0, 0.0), &b, xb, SPEC);
+        assert_eq!(m.count, 1);
+        assert_near_v(m.normal, Vec2::new(0.0, 1.0), 1e-6);
+        let p = m.points[0];
+        assert!((p.separation + 0.001).abs() < 1e-4, "{p:?}");
+        assert!((p.point.x - 0.3).abs() < 1e-4);
+        // Slight rocking keeps the same id (keyed by the corner vertex).
+        let m2 = collide(
+            &ground,
+            xf(0.0, 0.0, 0.0),
+            &b,
+            xf(0.3, 1.0 + h - 0.001, core::f32::consts::FRAC_PI_4 + 0.01),
+            SPEC,
+        );
+        let m3 = collide(
+            &ground,
+            xf(0.0, 0.0, 0.0),
+            &b,
+            xf(0.3, 1.0 + h - 0.001, core::f32::consts::FRAC_PI_4 - 0.01),
+            SPEC,
+        );
+        assert_eq!(m2.count, 1);
+        assert_eq!(m3.count, 1);
+        assert_eq!(m2.points[0].id, m3.points[0].id);
+    }
+
+    #[test]
+    fn very_different_sizes() {
+        // Small box on a huge box and a huge box on a small box.
+        let small = boxed(0.05, 0.05);
+        let big = boxed(10.0, 10.0);
+        let m = collide(&big, xf(0.0, 0.0, 0.0), &small, xf(-2.0, 10.05, 0.0), SPEC);
+        assert_eq!(m.count, 2);
+        let x = xs(&m);
+        assert!((x[0] + 2.05).abs() < 1e-4 && (x[1] + 1.95).abs() < 1e-4, "{x:?}");
+        let m = collide(&small, xf(0.0, 0.0, 0.0), &big, xf(3.0, 10.05, 0.0), SPEC);
+        assert_eq!(m.count, 2);
+        assert_near_v(m.normal, Vec2::new(0.0, 1.0), 1e-6);
+        let x = xs(&m);
+        assert!((x[0] + 0.05).abs() < 1e-4 && (x[1] - 0.05).abs() < 1e-4, "{x:?}");
+        for p in m.active_points() {
+            assert!(p.separation.abs() < 1e-4);
+        }
+    }
+
+    #[test]
+    fn rounded_boxes() {
+        let r = 0.1;
+        let a = Shape::Polygon(Polygon::new_rounded_box(0.4, 0.4, r).unwrap());
+        // Solid is 1 × 1; rest B's solid 5 mm into A's.
+        let m = collide(&a, xf(0.0, 0.0, 0.0), &a, xf(0.5, 0.995, 0.0), SPEC);
+        assert_eq!(m.count, 2);
+        for p in m.active_points() {
+            assert!((p.separation + 0.005).abs() < 1e-5, "{p:?}");
+            assert!((p.point.y - 0.4975).abs() < 1e-5, "{p:?}");
+        }
+        let x = xs(&m);
+        assert!((x[0] - 0.1).abs() < 1e-5 && (x[1] - 0.4).abs() < 1e-5, "{x:?}");
+        // Corner against corner, diagonally separated: the rounded corners give one point on
+        // the diagonal, separation = centre distance of the arcs − 2r.
+        let d = 0.8 + 0.2;
+        let m = collide(&a, xf(0.0, 0.0, 0.0), &a, xf(d, d, 0.0), SPEC);
+        assert_eq!(m.count, 0);
+        let d = 0.8 + (2.0 * r + 0.01) / 2.0f32.sqrt();
+        let m = collide(&a, xf(0.0, 0.0, 0.0), &a, xf(d, d, 0.0), SPEC);
+        assert_eq!(m.count, 1);
+        let s = core::f32::consts::FRAC_1_SQRT_2;
+        assert_near_v(m.normal, Vec2::new(s, s), 1e-5);
+        assert!((m.points[0].separation - 0.01).abs() < 1e-5);
+        // Midway between the arcs: (0.4 + δ/2) per axis with δ = d − 0.8, i.e. d/2.
+        assert_near_v(m.points[0].point, Vec2::new(0.5 * d, 0.5 * d), 1e-5);
+    }
+
+    #[test]
+    fn sharp_corner_to_corner_speculative() {
+        let a = boxed(0.5, 0.5);
+        // B's lower-left corner 6 mm right and 8 mm above A's upper-right corner: 1 cm apart.
+        let m = collide(&a, xf(0.0, 0.0, 0.0), &a, xf(1.006, 1.008, 0.0), SPEC);
+        assert_eq!(m.count, 1);
+        assert_near_v(m.normal, Vec2::new(0.6, 0.8), 1e-3);
+        assert!((m.points[0].separation - 0.01).abs() < 1e-5);
+        assert_near_v(m.points[0].point, Vec2::new(0.503, 0.504), 1e-5);
+    }
+
+    #[test]
+    fn ids_stable_when_sliding_and_distinct() {
+        let ground = boxed(50.0, 1.0);
+        let b = boxed(0.5, 0.5);
+        let m1 = collide(&ground, xf(0.0, 0.0, 0.0), &b, xf(3.0, 1.499, 0.0), SPEC);
+        let m2 = collide(&ground, xf(0.0, 0.0, 0.0), &b, xf(3.001, 1.499, 0.0), SPEC);
+        assert_eq!(m1.count, 2);
+        assert_eq!(m2.count, 2);
+        assert_ne!(m1.points[0].id, m1.points[1].id);
+        assert_eq!(m1.points[0].id, m2.points[0].id);
+        assert_eq!(m1.points[1].id, m2.points[1].id);
+        // Equal boxes, sliding past the edge of the lower one: one end gets clipped, ids stay.
+        let m3 = collide(&b, xf(0.0, 0.0, 0.0), &b, xf(0.3, 0.999, 0.0), SPEC);
+        let m4 = collide(&b, xf(0.0, 0.0, 0.0), &b, xf(0.301, 0.999, 0.0), SPEC);
+        let m5 = collide(&b, xf(0.0, 0.0, 0.0), &b, xf(-0.001, 0.999, 0.0), SPEC);
+        assert_eq!(m3.count, 2);
+        assert_ne!(m3.points[0].id, m3.points[1].id);
+        assert_eq!(ids(&m3), ids(&m4));
+        assert_eq!(ids(&m3), ids(&m5));
+    }
+
+    #[test]
+    fn reference_face_does_not_flip_for_equal_boxes() {
+        // Equal boxes: A's and B's faces tie; A stays the reference for tiny tilts.
+        let b = boxed(0.5, 0.5);
+        let m1 = collide(&b, xf(0.0, 0.0, 0.0), &b, xf(0.1, 0.999, 0.0), SPEC);
+        let m2 = collide(&b, xf(0.0, 0.0, 0.0), &b, xf(0.1, 0.999, 1e-5), SPEC);
+        assert_eq!(ids(&m1), ids(&m2));
+    }
+
+    #[test]
+    fn deep_overlap_and_garbage() {
+        let b = boxed(0.5, 0.5);
+        let m = collide(&b, xf(0.0, 0.0, 0.0), &b, xf(0.0, 0.1, 0.3), SPEC);
+        assert!(m.count >= 1);
+        for p in m.active_points() {
+            assert!(p.separation < 0.0 && p.separation.is_finite());
+        }
+        let m = collide(&b, xf(f32::NAN, 0.0, 0.0), &b, xf(0.0, 0.1, 0.3), SPEC);
+        assert_eq!(m.count, 0);
+        let m = collide(&b, xf(0.0, 0.0, f32::INFINITY), &b, xf(0.0, 0.1, 0.3), SPEC);
+        assert_eq!(m.count, 0);
+    }
+}

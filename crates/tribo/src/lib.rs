@@ -1,0 +1,64 @@
+//! # Tribo: 2D rigid bodies whose contacts get friction right
+//!
+//! Impulse-based rigid-body dynamics (sequential impulses with accumulated clamping, warm
+//! starting and sub-stepped soft contacts) with a true Coulomb friction model: every
+//! material has a static coefficient μs and a dynamic coefficient μd. A contact point
+//! *sticks* while the friction it needs stays within μs times its normal impulse and
+//! *slides* with exactly μd times its normal impulse otherwise.
+//!
+//! ```
+//! use tribo::{BodyDef, Material, Polygon, Shape, ShapeDef, Vec2, World, WorldDef};
+//!
+//! let mut world = World::new(WorldDef::default())?;
+//! let ground = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0)))?;
+//! world.create_shape(ground, &ShapeDef::default(), &Shape::Polygon(Polygon::new_box(50.0, 1.0)?))?;
+//! let crate_body = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 0.5)))?;
+//! let wood = Material::default().friction(0.6, 0.4);
+//! world.create_shape(crate_body, &ShapeDef::with_material(wood), &Shape::Polygon(Polygon::new_box(0.5, 0.5)?))?;
+//! for _ in 0..60 {
+//!     world.step(1.0 / 60.0)?;
+//! }
+//! let y = world.body_position(crate_body)?.y;
+//! assert!((y - 0.5).abs() < 0.01);
+//! # Ok::<(), tribo::Error>(())
+//! ```
+//!
+//! ## Table of contents
+//! - [`math`]: vectors, rotations, transforms, boxes.
+//! - [`geometry`]: pure shapes, hull, mass, ray casts, contact manifolds.
+//! - `collision`: dynamic AABB trees, broad phase, contact records (internal).
+//! - `dynamics`: bodies, shapes, [`Material`] and [`CombineRule`].
+//! - `solver`: the soft step and the contact constraint with stick/slip friction
+//!   (internal; its design is documented in `ARCHITECTURE.md`).
+//! - [`World`]: creation, the step, events, queries.
+//!
+//! ## Units & conventions
+//! - SI units: metres, kilograms, seconds, radians. 2D densities are kg/m², rotational
+//!   inertia kg·m², impulses N·s, torques N·m.
+//! - Angles are counter-clockwise; polygons are counter-clockwise.
+//! - A contact normal points from shape A to shape B; negative separation means overlap.
+//! - The friction tangent of a contact is `(n.y, −n.x)` (the normal turned clockwise).
+//! - Every public call that takes user input validates it: NaN, infinity and out-of-range
+//!   values return an [`Error`] and change nothing.
+//! - Same scene, same build → bit-identical results (no hash-order iteration, no threads
+//!   racing, no fused multiply-add).
+
+#![warn(missing_docs)]
+
+mod collision;
+mod dynamics;
+mod error;
+pub mod geometry;
+pub mod math;
+mod solver;
+mod world;
+
+pub use collision::FrictionState;
+pub use dynamics::{mix, BodyDef, BodyType, CombineRule, Filter, Material, MixedMaterial, ShapeDef};
+pub use error::{Error, Result};
+pub use geometry::{Capsule, Circle, GeometryError, MassData, Polygon, Segment, Shape};
+pub use math::{Aabb, Rot, Transform, Vec2};
+pub use world::{
+    BodyId, ContactBeginEvent, ContactEndEvent, ContactEvents, ContactInfo, ContactPointInfo, QueryFilter, RayResult,
+    ShapeId, World, WorldDef,
+};

@@ -1,0 +1,143 @@
+//! The solver: sub-stepped soft sequential impulses (Box2D v3's "soft step", read from its
+//! source and the Solver2D write-up, implemented anew).
+//!
+//! Pipeline stage: after the narrow phase, before finalize. The stage order of one step:
+//!
+//! 1. prepare constraints (anchors, effective masses, softness, warm-start impulses)
+//! 2. for each of the `substeps` substeps of length `h = dt / substeps`:
+//!    1. integrate velocities (gravity, forces, damping)
+//!    2. warm start (re-apply the accumulated impulses)
+//!    3. solve with bias (soft position correction, static-friction anchors)
+//!    4. integrate positions (accumulate Δp, Δq)
+//!    5. relax (solve again without bias, removing the correction velocity)
+//! 3. restitution (one pass, from the recorded impact velocities)
+//! 4. store impulses and friction states back into the contacts
+//!
+//! Constraints join the solver through [`ConstraintSet`]; contacts are the one set today,
+//! joints will be another.
+
+pub(crate) mod contact_solver;
+pub(crate) mod softness;
+
+use crate::math::{Rot, Vec2};
+pub(crate) use softness::Softness;
+
+/// Velocity and accumulated motion of one awake body during a step (32 bytes, hot).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct BodyState {
+    /// Linear velocity of the centre of mass [m/s].
+    pub v: Vec2,
+    /// Angular velocity [rad/s].
+    pub w: f32,
+    /// Padding kept for a 32-byte layout (reserved for flags).
+    pub _pad: f32,
+    /// Translation of the centre of mass since the start of the step [m].
+    pub dp: Vec2,
+    /// Rotation since the start of the step.
+    pub dq: Rot,
+}
+
+/// Per-body constants of a step (cold relative to [`BodyState`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct BodySim {
+    pub inv_mass: f32,
+    pub inv_inertia: f32,
+    /// Acceleration from gravity and applied forces [m/s²].
+    pub linear_accel: Vec2,
+    /// Angular acceleration from applied torques [rad/s²].
+    pub angular_accel: f32,
+    pub linear_damping: f32,
+    pub angular_damping: f32,
+    /// Body slot index in the world.
+    pub body: u32,
+}
+
+/// Tunable numbers of the solver, fixed for one step.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct StepContext {
+    pub dt: f32,
+    pub h: f32,
+    pub inv_h: f32,
+    pub substeps: u32,
+    /// Softness of contacts between two moving bodies.
+    pub contact_softness: Softness,
+    /// Softness of contacts with a static body (twice the frequency, as in Box2D v3).
+    pub static_softness: Softness,
+    /// Contact frequency [Hz] used for the base softness (after clamping).
+    pub contact_hertz: f32,
+    pub contact_damping_ratio: f32,
+    /// Largest speed at which overlap is pushed apart [m/s].
+    pub push_speed: f32,
+    /// Largest static deflection a contact may show under its current load [m].
+    pub max_deflection: f32,
+    /// Slip speed below which a sliding point sticks again [m/s].
+    pub stick_speed: f32,
+    /// Largest linear speed [m/s].
+    pub max_linear_speed: f32,
+    pub warm_starting: bool,
+}
+
+/// A family of constraints solved by the step (contacts now; joints later).
+pub(crate) trait ConstraintSet {
+    /// Computes anchors, masses and softness; loads warm-start impulses.
+    fn prepare(&mut self, ctx: &StepContext, states: &[BodyState]);
+    /// Re-applies the accumulated impulses at the start of a substep.
+    fn warm_start(&mut self, states: &mut [BodyState]);
+    /// One sequential-impulse pass; `use_bias` adds the soft position correction.
+    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, elapsed: f32);
+    /// Accumulates what a substep applied (after its relax pass).
+    fn end_substep(&mut self);
+    /// Restitution pass after all substeps.
+    fn restitution(&mut self, states: &mut [BodyState]);
+}
+
+/// Runs the stages of one step over the awake bodies and a constraint set.
+pub(crate) fn solve_step<C: ConstraintSet>(
+    ctx: &StepContext,
+    sims: &[BodySim],
+    states: &mut [BodyState],
+    constraints: &mut C,
+) {
+    constraints.prepare(ctx, states);
+    for i in 0..ctx.substeps {
+        integrate_velocities(ctx, sims, states);
+        if ctx.warm_starting {
+            constraints.warm_start(states);
+        }
+        let elapsed = i as f32 * ctx.h;
+        constraints.solve(ctx, states, true, elapsed);
+        integrate_positions(ctx, states);
+        constraints.solve(ctx, states, false, elapsed + ctx.h);
+        constraints.end_substep();
+    }
+    constraints.restitution(states);
+}
+
+/// v ← (v + h·a) / (1 + h·c): explicit forces, Padé damping (Box2D v3).
+fn integrate_velocities(ctx: &StepContext, sims: &[BodySim], states: &mut [BodyState]) {
+    let h = ctx.h;
+    // Index 0 is the shared static body: it never moves.
+    for (sim, s) in sims.iter().zip(states.iter_mut()).skip(1) {
+        let lin = 1.0 / (1.0 + h * sim.linear_damping);
+        let ang = 1.0 / (1.0 + h * sim.angular_damping);
+        s.v = (s.v + h * sim.linear_accel) * lin;
+        s.w = (s.w + h * sim.angular_accel) * ang;
+    }
+}
+
+/// Accumulates Δp += h·v and Δq ← Δq advanced by h·ω, with speed limits.
+fn integrate_positions(ctx: &StepContext, states: &mut [BodyState]) {
+    let h = ctx.h;
+    // Rotation per substep is limited to 0.25π per full step, as in Box2D, so the
+    // first-order rotation update stays accurate.
+    let max_w = 0.25 * core::f32::consts::PI / ctx.dt;
+    let max_v2 = ctx.max_linear_speed * ctx.max_linear_speed;
+    for s in states.iter_mut().skip(1) {
+        if s.v.length_squared() > max_v2 {
+            s.v = s.v * (ctx.max_linear_speed / s.v.length());
+        }
+        s.w = s.w.clamp(-max_w, max_w);
+        s.dp += h * s.v;
+        s.dq = s.dq.integrate(h * s.w);
+    }
+}

@@ -1,0 +1,916 @@
+//! The world: owns bodies, shapes and contacts; steps them; answers queries.
+//!
+//! Pipeline stage: all of them — [`World::step`] (in `step.rs`) reads as the table of
+//! contents of a step. This file holds the definition and the public API for creating,
+//! destroying, reading and changing bodies and shapes.
+
+mod events;
+mod ids;
+mod query;
+mod step;
+
+pub use events::{ContactBeginEvent, ContactEndEvent, ContactEvents, ContactInfo, ContactPointInfo};
+pub use ids::{BodyId, ShapeId};
+pub use query::{QueryFilter, RayResult};
+
+pub(crate) use ids::Arena;
+
+use crate::collision::broad_phase::{BroadPhase, AABB_MARGIN, MOVING_TREE, STATIC_TREE};
+use crate::collision::contact::Contact;
+use crate::dynamics::body::Body;
+use crate::dynamics::shape::ShapeRecord;
+use crate::dynamics::{BodyDef, BodyType, Filter, Material, ShapeDef};
+use crate::error::{check_finite, check_non_negative, check_positive, check_vec, Error, Result};
+use crate::geometry::{Shape, SPECULATIVE_DISTANCE};
+use crate::math::{Aabb, Rot, Transform, Vec2};
+use crate::solver::contact_solver::ContactSolver;
+use crate::solver::{BodySim, BodyState};
+
+/// World settings. Every field has a default (listed on the field) that matches Box2D v3
+/// where Box2D has the same setting, so scenes port.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorldDef {
+    /// Gravity [m/s²]. Default (0, −9.81).
+    pub gravity: Vec2,
+    /// Substeps per step, ≥ 1. Default 4.
+    pub substeps: u32,
+    /// Contact stiffness [Hz] between moving bodies; contacts with static bodies use twice
+    /// this. Clamped to at most 1/8 of the substep rate (30 Hz at 60 Hz × 4). Default 30.
+    pub contact_hertz: f32,
+    /// Contact damping ratio (dimensionless). Default 10 (heavily damped, no bounce).
+    pub contact_damping_ratio: f32,
+    /// Largest speed at which overlapping shapes are pushed apart [m/s]. Default 3.
+    pub contact_push_speed: f32,
+    /// Largest static deflection [m] a contact may show under its load: heavily loaded
+    /// contacts are stiffened until they sink no more than this (what keeps a heavy box
+    /// from sinking into a light one). Default 0.0002 m (0.2 mm); 0 disables.
+    pub max_contact_deflection: f32,
+    /// Slip speed [m/s] below which a sliding contact point sticks again. Default 0.01.
+    pub stick_speed: f32,
+    /// Largest linear speed of any body [m/s]. Default 400.
+    pub max_linear_speed: f32,
+    /// Whether bodies may fall asleep. Default true.
+    pub enable_sleep: bool,
+    /// Time [s] an island must rest before it sleeps. Default 0.5.
+    pub time_to_sleep: f32,
+    /// Whether impulses carry over between steps. Default true.
+    pub warm_starting: bool,
+}
+
+impl Default for WorldDef {
+    fn default() -> Self {
+        WorldDef {
+            gravity: Vec2::new(0.0, -9.81),
+            substeps: 4,
+            contact_hertz: 30.0,
+            contact_damping_ratio: 10.0,
+            contact_push_speed: 3.0,
+            max_contact_deflection: 0.0002,
+            stick_speed: 0.01,
+            max_linear_speed: 400.0,
+            enable_sleep: true,
+            time_to_sleep: 0.5,
+            warm_starting: true,
+        }
+    }
+}
+
+impl WorldDef {
+    /// Checks every field.
+    pub fn validate(&self) -> Result<()> {
+        check_vec("WorldDef::gravity", self.gravity)?;
+        if self.substeps == 0 || self.substeps > 64 {
+            return Err(Error::arg(
+                "WorldDef::substeps",
+                format!("must be in 1..=64 (got {})", self.substeps),
+            ));
+        }
+        check_non_negative("WorldDef::contact_hertz", self.contact_hertz)?;
+        check_non_negative("WorldDef::contact_damping_ratio", self.contact_damping_ratio)?;
+        check_positive("WorldDef::contact_push_speed", self.contact_push_speed)?;
+        check_non_negative("WorldDef::max_contact_deflection", self.max_contact_deflection)?;
+        check_non_negative("WorldDef::stick_speed", self.stick_speed)?;
+        check_positive("WorldDef::max_linear_speed", self.max_linear_speed)?;
+        check_non_negative("WorldDef::time_to_sleep", self.time_to_sleep)?;
+        Ok(())
+    }
+}
+
+/// A 2D physics world.
+pub struct World {
+    pub(crate) def: WorldDef,
+    pub(crate) bodies: Arena<Body>,
+    pub(crate) shapes: Arena<ShapeRecord>,
+    pub(crate) contacts: Vec<Option<Contact>>,
+    pub(crate) contact_free: Vec<u32>,
+    pub(crate) broad_phase: BroadPhase,
+    pub(crate) events: ContactEvents,
+    /// Bodies of each sleeping island (slot = island id); `None` = free slot.
+    pub(crate) sleep_islands: Vec<Option<Vec<u32>>>,
+    pub(crate) island_free: Vec<u32>,
+    /// Bodies whose state became non-finite in the last step (frozen and reported).
+    pub(crate) non_finite: Vec<BodyId>,
+    // Scratch buffers reused every step (no per-step allocation once warm).
+    pub(crate) states: Vec<BodyState>,
+    pub(crate) sims: Vec<BodySim>,
+    pub(crate) contact_solver: ContactSolver,
+    pub(crate) scratch_u32: Vec<u32>,
+    pub(crate) scratch_f32: Vec<f32>,
+    pub(crate) step_count: u64,
+}
+
+impl World {
+    /// Makes an empty world; errors if a setting is out of range.
+    pub fn new(def: WorldDef) -> Result<World> {
+        def.validate()?;
+        Ok(World {
+            def,
+            bodies: Arena::default(),
+            shapes: Arena::default(),
+            contacts: Vec::new(),
+            contact_free: Vec::new(),
+            broad_phase: BroadPhase::default(),
+            events: ContactEvents::default(),
+            sleep_islands: Vec::new(),
+            island_free: Vec::new(),
+            non_finite: Vec::new(),
+            states: Vec::new(),
+            sims: Vec::new(),
+            contact_solver: ContactSolver::default(),
+            scratch_u32: Vec::new(),
+            scratch_f32: Vec::new(),
+            step_count: 0,
+        })
+    }
+
+    /// The settings in force.
+    pub fn def(&self) -> &WorldDef {
+        &self.def
+    }
+
+    /// Replaces the settings (validated first; on error nothing changes).
+    pub fn set_def(&mut self, def: WorldDef) -> Result<()> {
+        def.validate()?;
+        self.def = def;
+        Ok(())
+    }
+
+    /// Gravity [m/s²].
+    pub fn gravity(&self) -> Vec2 {
+        self.def.gravity
+    }
+
+    /// Sets gravity [m/s²] and wakes every body.
+    pub fn set_gravity(&mut self, gravity: Vec2) -> Result<()> {
+        check_vec("gravity", gravity)?;
+        self.def.gravity = gravity;
+        self.wake_all();
+        Ok(())
+    }
+
+    /// Number of live bodies.
+    pub fn body_count(&self) -> usize {
+        self.bodies.len()
+    }
+
+    /// Number of live shapes.
+    pub fn shape_count(&self) -> usize {
+        self.shapes.len()
+    }
+
+    /// Number of contact records (pairs whose fat boxes overlap, touching or not).
+    pub fn contact_count(&self) -> usize {
+        self.contacts.len() - self.contact_free.len()
+    }
+
+    /// Number of steps taken.
+    pub fn step_count(&self) -> u64 {
+        self.step_count
+    }
+
+    /// Ids of all live bodies in creation-slot order.
+    pub fn body_ids(&self) -> Vec<BodyId> {
+        self.bodies
+            .iter()
+            .map(|(i, _)| BodyId {
+                index: i,
+                generation: self.bodies.generation(i),
+            })
+            .collect()
+    }
+
+    // ----------------------------------------------------------------------------------
+    // Bodies
+    // ----------------------------------------------------------------------------------
+
+    /// Creates a body. It has no shapes yet: a dynamic body without shapes gets a mass of
+    /// 1 kg at its origin.
+    pub fn create_body(&mut self, def: &BodyDef) -> Result<BodyId> {
+        def.validate()?;
+        let mut body = Body::new(def);
+        if body.body_type == BodyType::Dynamic {
+            body.mass = 1.0;
+            body.inv_mass = 1.0;
+        }
+        let (index, generation) = self.bodies.insert(body);
+        let id = BodyId { index, generation };
+        if !def.awake && def.body_type != BodyType::Static {
+            self.put_to_sleep(&[index]);
+        }
+        Ok(id)
+    }
+
+    /// Destroys a body, its shapes and its contacts (end-touch events are reported).
+    pub fn destroy_body(&mut self, id: BodyId) -> Result<()> {
+        let shapes = self.body_ref(id)?.shapes.clone();
+        self.wake_body(id.index);
+        for s in shapes {
+            self.remove_shape_internal(s);
+        }
+        self.bodies.remove(id.index, id.generation);
+        Ok(())
+    }
+
+    pub(crate) fn body_ref(&self, id: BodyId) -> Result<&Body> {
+        self.bodies.get(id.index, id.generation).ok_or(Error::InvalidBody(id))
+    }
+
+    pub(crate) fn body_mut(&mut self, id: BodyId) -> Result<&mut Body> {
+        self.bodies
+            .get_mut(id.index, id.generation)
+            .ok_or(Error::InvalidBody(id))
+    }
+
+    /// Whether the id refers to a live body.
+    pub fn contains_body(&self, id: BodyId) -> bool {
+        self.bodies.get(id.index, id.generation).is_some()
+    }
+
+    /// Body type.
+    pub fn body_type(&self, id: BodyId) -> Result<BodyType> {
+        Ok(self.body_ref(id)?.body_type)
+    }
+
+    /// Position of the body origin [m].
+    pub fn body_position(&self, id: BodyId) -> Result<Vec2> {
+        Ok(self.body_ref(id)?.xf.p)
+    }
+
+    /// Rotation angle [rad] in (−π, π].
+    pub fn body_angle(&self, id: BodyId) -> Result<f32> {
+        Ok(self.body_ref(id)?.xf.q.angle())
+    }
+
+    /// Pose of the body origin.
+    pub fn body_transform(&self, id: BodyId) -> Result<Transform> {
+        Ok(self.body_ref(id)?.xf)
+    }
+
+    /// World position of the centre of mass [m].
+    pub fn body_center_of_mass(&self, id: BodyId) -> Result<Vec2> {
+        Ok(self.body_ref(id)?.center)
+    }
+
+    /// Centre of mass in the body frame [m].
+    pub fn body_local_center_of_mass(&self, id: BodyId) -> Result<Vec2> {
+        Ok(self.body_ref(id)?.local_center)
+    }
+
+    /// Velocity of the centre of mass [m/s].
+    pub fn body_linear_velocity(&self, id: BodyId) -> Result<Vec2> {
+        Ok(self.body_ref(id)?.v)
+    }
+
+    /// Angular velocity [rad/s].
+    pub fn body_angular_velocity(&self, id: BodyId) -> Result<f32> {
+        Ok(self.body_ref(id)?.w)
+    }
+
+    /// Velocity [m/s] of the body's material point at a world point [m].
+    pub fn body_velocity_at_point(&self, id: BodyId, world_point: Vec2) -> Result<Vec2> {
+        check_vec("world_point", world_point)?;
+        let b = self.body_ref(id)?;
+        Ok(b.v + Vec2::cross_sv(b.w, world_point - b.center))
+    }
+
+    /// Mass [kg] (0 for static and kinematic bodies).
+    pub fn body_mass(&self, id: BodyId) -> Result<f32> {
+        Ok(self.body_ref(id)?.mass)
+    }
+
+    /// Rotational inertia about the centre of mass [kg·m²] (0 if rotation is fixed).
+    pub fn body_rotational_inertia(&self, id: BodyId) -> Result<f32> {
+        Ok(self.body_ref(id)?.inertia)
+    }
+
+    /// Whether the body is awake (static bodies count as awake).
+    pub fn body_is_awake(&self, id: BodyId) -> Result<bool> {
+        Ok(self.body_ref(id)?.awake)
+    }
+
+    /// The user data given at creation.
+    pub fn body_user_data(&self, id: BodyId) -> Result<u64> {
+        Ok(self.body_ref(id)?.user_data)
+    }
+
+    /// The body's shapes in attachment order.
+    pub fn body_shapes(&self, id: BodyId) -> Result<Vec<ShapeId>> {
+        Ok(self.body_ref(id)?.shapes.clone())
+    }
+
+    /// Moves the body origin to `position` [m] with rotation `angle` [rad] (teleport: no
+    /// velocity change) and wakes it.
+    pub fn set_body_transform(&mut self, id: BodyId, position: Vec2, angle: f32) -> Result<()> {
+        check_vec("position", position)?;
+        check_finite("angle", angle)?;
+        let b = self.body_mut(id)?;
+        b.xf = Transform::new(position, angle);
+        b.center = b.xf.apply(b.local_center);
+        b.center0 = b.center;
+        self.wake_body(id.index);
+        self.refresh_body_proxies(id.index, 0.0);
+        Ok(())
+    }
+
+    /// Sets the velocity of the centre of mass [m/s] and wakes the body (ignored for
+    /// static bodies).
+    pub fn set_body_linear_velocity(&mut self, id: BodyId, v: Vec2) -> Result<()> {
+        check_vec("linear_velocity", v)?;
+        let b = self.body_mut(id)?;
+        if b.body_type != BodyType::Static {
+            b.v = v;
+            self.wake_body(id.index);
+        }
+        Ok(())
+    }
+
+    /// Sets the angular velocity [rad/s] and wakes the body (ignored for static bodies and
+    /// for dynamic bodies with fixed rotation).
+    pub fn set_body_angular_velocity(&mut self, id: BodyId, w: f32) -> Result<()> {
+        check_finite("angular_velocity", w)?;
+        let b = self.body_mut(id)?;
+        if b.body_type != BodyType::Static && !(b.fixed_rotation && b.is_dynamic()) {
+            b.w = w;
+            self.wake_body(id.index);
+        }
+        Ok(())
+    }
+
+    /// Applies a force [N] at a world point [m] during the next step (then cleared).
+    /// Wakes the body when `wake` is true; a sleeping body not woken ignores the force.
+    pub fn apply_force(&mut self, id: BodyId, force: Vec2, world_point: Vec2, wake: bool) -> Result<()> {
+        check_vec("force", force)?;
+        check_vec("world_point", world_point)?;
+        self.body_ref(id)?;
+        if wake {
+            self.wake_body(id.index);
+        }
+        let b = self.body_mut(id)?;
+        if b.is_dynamic() && b.awake {
+            b.force += force;
+            b.torque += (world_point - b.center).cross(force);
+        }
+        Ok(())
+    }
+
+    /// Applies a force [N] at the centre of mass during the next step.
+    pub fn apply_force_to_center(&mut self, id: BodyId, force: Vec2, wake: bool) -> Result<()> {
+        let c = self.body_ref(id)?.center;
+        self.apply_force(id, force, c, wake)
+    }
+
+    /// Applies a torque [N·m] during the next step.
+    pub fn apply_torque(&mut self, id: BodyId, torque: f32, wake: bool) -> Result<()> {
+        check_finite("torque", torque)?;
+        self.body_ref(id)?;
+        if wake {
+            self.wake_body(id.index);
+        }
+        let b = self.body_mut(id)?;
+        if b.is_dynamic() && b.awake {
+            b.torque += torque;
+        }
+        Ok(())
+    }
+
+    /// Applies an impulse [N·s] at a world point [m]: changes the velocity at once.
+    pub fn apply_linear_impulse(&mut self, id: BodyId, impulse: Vec2, world_point: Vec2, wake: bool) -> Result<()> {
+        check_vec("impulse", impulse)?;
+        check_vec("world_point", world_point)?;
+        self.body_ref(id)?;
+        if wake {
+            self.wake_body(id.index);
+        }
+        let b = self.body_mut(id)?;
+        if b.is_dynamic() && b.awake {
+            b.v += b.inv_mass * impulse;
+            b.w += b.inv_inertia * (world_point - b.center).cross(impulse);
+        }
+        Ok(())
+    }
+
+    /// Applies an impulse [N·s] at the centre of mass.
+    pub fn apply_linear_impulse_to_center(&mut self, id: BodyId, impulse: Vec2, wake: bool) -> Result<()> {
+        let c = self.body_ref(id)?.center;
+        self.apply_linear_impulse(id, impulse, c, wake)
+    }
+
+    /// Applies an angular impulse [N·m·s].
+    pub fn apply_angular_impulse(&mut self, id: BodyId, impulse: f32, wake: bool) -> Result<()> {
+        check_finite("impulse", impulse)?;
+        self.body_ref(id)?;
+        if wake {
+            self.wake_body(id.index);
+        }
+        let b = self.body_mut(id)?;
+        if b.is_dynamic() && b.awake {
+            b.w += b.inv_inertia * impulse;
+        }
+        Ok(())
+    }
+
+    /// Sets the constant force [N] applied at the centre of mass every step; wakes the body.
+    pub fn set_body_constant_force(&mut self, id: BodyId, force: Vec2) -> Result<()> {
+        check_vec("constant_force", force)?;
+        self.body_mut(id)?.constant_force = force;
+        self.wake_body(id.index);
+        Ok(())
+    }
+
+    /// Sets the constant torque [N·m] applied every step; wakes the body.
+    pub fn set_body_constant_torque(&mut self, id: BodyId, torque: f32) -> Result<()> {
+        check_finite("constant_torque", torque)?;
+        self.body_mut(id)?.constant_torque = torque;
+        self.wake_body(id.index);
+        Ok(())
+    }
+
+    /// Sets the gravity scale (dimensionless); wakes the body.
+    pub fn set_body_gravity_scale(&mut self, id: BodyId, scale: f32) -> Result<()> {
+        check_finite("gravity_scale", scale)?;
+        self.body_mut(id)?.gravity_scale = scale;
+        self.wake_body(id.index);
+        Ok(())
+    }
+
+    /// Sets linear and angular damping [1/s].
+    pub fn set_body_damping(&mut self, id: BodyId, linear: f32, angular: f32) -> Result<()> {
+        check_non_negative("linear_damping", linear)?;
+        check_non_negative("angular_damping", angular)?;
+        let b = self.body_mut(id)?;
+        b.linear_damping = linear;
+        b.angular_damping = angular;
+        Ok(())
+    }
+
+    /// Fixes or frees the rotation of a body; recomputes its mass data.
+    pub fn set_body_fixed_rotation(&mut self, id: BodyId, fixed: bool) -> Result<()> {
+        let b = self.body_mut(id)?;
+        b.fixed_rotation = fixed;
+        if fixed {
+            b.w = 0.0;
+        }
+        self.update_mass(id.index);
+        self.wake_body(id.index);
+        Ok(())
+    }
+
+    /// Wakes (`true`) or puts to sleep (`false`, with its whole island) a body.
+    pub fn set_body_awake(&mut self, id: BodyId, awake: bool) -> Result<()> {
+        let b = self.body_ref(id)?;
+        if b.body_type == BodyType::Static {
+            return Ok(());
+        }
+        if awake {
+            self.wake_body(id.index);
+        } else if b.awake {
+            let island = self.island_of(id.index);
+            self.put_to_sleep(&island);
+        }
+        Ok(())
+    }
+
+    // ----------------------------------------------------------------------------------
+    // Shapes
+    // ----------------------------------------------------------------------------------
+
+    /// Attaches a shape to a body and updates the body's mass, centre of mass and inertia.
+    /// Segments are meant for static ground: on a dynamic body they add no mass.
+    pub fn create_shape(&mut self, body: BodyId, def: &ShapeDef, geometry: &Shape) -> Result<ShapeId> {
+        def.material.validate()?;
+        validate_geometry(geometry)?;
+        let b = self.body_ref(body)?;
+        let tree = if b.body_type == BodyType::Static {
+            STATIC_TREE
+        } else {
+            MOVING_TREE
+        };
+        let xf = b.xf;
+        let v = b.v;
+        let record = ShapeRecord {
+            body,
+            geometry: *geometry,
+            material: def.material,
+            filter: def.filter,
+            user_data: def.user_data,
+            proxy: u32::MAX,
+            tree,
+            fat_aabb: Aabb::new(Vec2::ZERO, Vec2::ZERO),
+            moved: false,
+        };
+        let (index, generation) = self.shapes.insert(record);
+        let id = ShapeId { index, generation };
+        let fat = shape_box(geometry, xf, v, 0.0).expand(AABB_MARGIN);
+        let proxy = self.broad_phase.create_proxy(tree, fat, def.filter.category, index);
+        if let Some(s) = self.shapes.at_mut(index) {
+            s.proxy = proxy;
+            s.fat_aabb = fat;
+        }
+        if let Some(b) = self.bodies.at_mut(body.index) {
+            b.shapes.push(id);
+        }
+        self.update_mass(body.index);
+        self.wake_body(body.index);
+        Ok(id)
+    }
+
+    /// Detaches and destroys a shape (its contacts end; the body's mass is recomputed).
+    pub fn destroy_shape(&mut self, id: ShapeId) -> Result<()> {
+        let body = self.shape_ref(id)?.body;
+        self.wake_body(body.index);
+        self.remove_shape_internal(id);
+        if let Some(b) = self.bodies.at_mut(body.index) {
+            b.shapes.retain(|s| *s != id);
+        }
+        self.update_mass(body.index);
+        Ok(())
+    }
+
+    pub(crate) fn shape_ref(&self, id: ShapeId) -> Result<&ShapeRecord> {
+        self.shapes.get(id.index, id.generation).ok_or(Error::InvalidShape(id))
+    }
+
+    /// Whether the id refers to a live shape.
+    pub fn contains_shape(&self, id: ShapeId) -> bool {
+        self.shapes.get(id.index, id.generation).is_some()
+    }
+
+    /// The body a shape is attached to.
+    pub fn shape_body(&self, id: ShapeId) -> Result<BodyId> {
+        Ok(self.shape_ref(id)?.body)
+    }
+
+    /// A shape's geometry (in its body's frame).
+    pub fn shape_geometry(&self, id: ShapeId) -> Result<Shape> {
+        Ok(self.shape_ref(id)?.geometry)
+    }
+
+    /// A shape's material.
+    pub fn shape_material(&self, id: ShapeId) -> Result<Material> {
+        Ok(self.shape_ref(id)?.material)
+    }
+
+    /// A shape's filter.
+    pub fn shape_filter(&self, id: ShapeId) -> Result<Filter> {
+        Ok(self.shape_ref(id)?.filter)
+    }
+
+    /// A shape's user data.
+    pub fn shape_user_data(&self, id: ShapeId) -> Result<u64> {
+        Ok(self.shape_ref(id)?.user_data)
+    }
+
+    /// Tight world bounding box of a shape [m].
+    pub fn shape_aabb(&self, id: ShapeId) -> Result<Aabb> {
+        let s = self.shape_ref(id)?;
+        let xf = self.body_ref(s.body)?.xf;
+        Ok(s.geometry.aabb(xf))
+    }
+
+    /// Replaces a shape's material (validated first). Existing contacts pick the new
+    /// coefficients up at once; the body's mass is recomputed if the density changed.
+    pub fn set_shape_material(&mut self, id: ShapeId, material: Material) -> Result<()> {
+        material.validate()?;
+        let s = self
+            .shapes
+            .get_mut(id.index, id.generation)
+            .ok_or(Error::InvalidShape(id))?;
+        let density_changed = s.material.density != material.density;
+        s.material = material;
+        let body = s.body;
+        self.remix_contacts(body.index);
+        if density_changed {
+            self.update_mass(body.index);
+        }
+        self.wake_body(body.index);
+        Ok(())
+    }
+
+    /// Replaces a shape's collision filter. Pairs that the new filter forbids end at the
+    /// next step; pairs it allows begin as the broad phase finds them.
+    pub fn set_shape_filter(&mut self, id: ShapeId, filter: Filter) -> Result<()> {
+        let s = self
+            .shapes
+            .get_mut(id.index, id.generation)
+            .ok_or(Error::InvalidShape(id))?;
+        s.filter = filter;
+        let (tree, proxy, fat, body) = (s.tree, s.proxy, s.fat_aabb, s.body);
+        // Re-insert so the tree's category bits and the pair search see the new filter.
+        self.broad_phase.destroy_proxy(tree, proxy);
+        let new_proxy = self.broad_phase.create_proxy(tree, fat, filter.category, id.index);
+        if let Some(s) = self.shapes.at_mut(id.index) {
+            s.proxy = new_proxy;
+        }
+        self.wake_body(body.index);
+        Ok(())
+    }
+
+    // ----------------------------------------------------------------------------------
+    // Internals shared by the API and the step
+    // ----------------------------------------------------------------------------------
+
+    /// Recomputes mass, centre of mass, inertia and extent from the body's shapes.
+    /// Keeps the origin fixed; the centre-of-mass velocity follows the moved centre.
+    pub(crate) fn update_mass(&mut self, body_index: u32) {
+        let Some(b) = self.bodies.at(body_index) else { return };
+        let shapes: Vec<Shape> = b
+            .shapes
+            .iter()
+            .filter_map(|s| {
+                self.shapes
+                    .get(s.index, s.generation)
+                    .map(|r| (r.geometry, r.material.density))
+            })
+            .map(|(g, _)| g)
+            .collect();
+        let densities: Vec<f32> = b
+            .shapes
+            .iter()
+            .filter_map(|s| self.shapes.get(s.index, s.generation).map(|r| r.material.density))
+            .collect();
+        let Some(b) = self.bodies.at_mut(body_index) else {
+            return;
+        };
+        let old_center = b.center;
+        let (mut mass, mut moment, mut weighted) = (0.0f32, 0.0f32, Vec2::ZERO);
+        if b.body_type == BodyType::Dynamic {
+            for (g, &rho) in shapes.iter().zip(&densities) {
+                let md = g.mass(rho);
+                mass += md.mass;
+                weighted += md.mass * md.center;
+                // inertia about the body origin: I_c + m |c|²
+                moment += md.rotational_inertia + md.mass * md.center.length_squared();
+            }
+        }
+        if b.body_type == BodyType::Dynamic && mass > 0.0 {
+            let local_center = weighted * (1.0 / mass);
+            b.mass = mass;
+            b.inv_mass = 1.0 / mass;
+            b.local_center = local_center;
+            let inertia = moment - mass * local_center.length_squared();
+            if inertia > 0.0 && !b.fixed_rotation {
+                b.inertia = inertia;
+                b.inv_inertia = 1.0 / inertia;
+            } else {
+                b.inertia = 0.0;
+                b.inv_inertia = 0.0;
+            }
+        } else if b.body_type == BodyType::Dynamic {
+            // No mass from shapes: 1 kg at the origin, Box2D's choice.
+            b.mass = 1.0;
+            b.inv_mass = 1.0;
+            b.local_center = Vec2::ZERO;
+            b.inertia = 0.0;
+            b.inv_inertia = 0.0;
+        } else {
+            b.mass = 0.0;
+            b.inv_mass = 0.0;
+            b.inertia = 0.0;
+            b.inv_inertia = 0.0;
+            b.local_center = Vec2::ZERO;
+        }
+        if b.fixed_rotation && b.is_dynamic() {
+            b.w = 0.0;
+        }
+        b.center = b.xf.apply(b.local_center);
+        b.center0 = b.center;
+        // Velocity of the new centre of mass: v + ω × (c_new − c_old).
+        b.v += Vec2::cross_sv(b.w, b.center - old_center);
+        let lc = b.local_center;
+        b.max_extent = shapes.iter().map(|g| g.max_extent(lc)).fold(0.0, f32::max);
+    }
+
+    /// Re-mixes the materials of every contact of a body.
+    fn remix_contacts(&mut self, body_index: u32) {
+        let Some(b) = self.bodies.at(body_index) else { return };
+        for &ci in &b.contacts {
+            if let Some(Some(c)) = self.contacts.get_mut(ci as usize) {
+                if let (Some(sa), Some(sb)) = (
+                    self.shapes.get(c.shape_a.index, c.shape_a.generation),
+                    self.shapes.get(c.shape_b.index, c.shape_b.generation),
+                ) {
+                    c.material = crate::dynamics::mix(&sa.material, &sb.material);
+                }
+            }
+        }
+    }
+
+    /// Removes a shape's proxy and contacts and the shape itself (not its body link).
+    fn remove_shape_internal(&mut self, id: ShapeId) {
+        let Some(s) = self.shapes.get(id.index, id.generation) else {
+            return;
+        };
+        let (tree, proxy, body) = (s.tree, s.proxy, s.body);
+        let contacts: Vec<u32> = self
+            .bodies
+            .at(body.index)
+            .map(|b| b.contacts.clone())
+            .unwrap_or_default();
+        for ci in contacts {
+            let involved =
+                matches!(self.contacts.get(ci as usize), Some(Some(c)) if c.shape_a == id || c.shape_b == id);
+            if involved {
+                self.destroy_contact(ci, true);
+            }
+        }
+        self.broad_phase.destroy_proxy(tree, proxy);
+        self.shapes.remove(id.index, id.generation);
+    }
+
+    /// Updates the fat boxes of a body's shapes after its pose changed.
+    /// `dt` > 0 also sweeps the boxes along the body's velocity for the next step.
+    pub(crate) fn refresh_body_proxies(&mut self, body_index: u32, dt: f32) {
+        let Some(b) = self.bodies.at(body_index) else { return };
+        let (xf, v) = (b.xf, b.v);
+        let shapes = b.shapes.clone();
+        for sid in shapes {
+            let Some(s) = self.shapes.get_mut(sid.index, sid.generation) else {
+                continue;
+            };
+            let aabb = shape_box(&s.geometry, xf, v, dt);
+            if !s.fat_aabb.contains(aabb) || dt == 0.0 {
+                let fat = aabb.expand(AABB_MARGIN);
+                s.fat_aabb = fat;
+                let (tree, proxy) = (s.tree, s.proxy);
+                self.broad_phase.move_proxy(tree, proxy, fat, sid.index);
+            }
+        }
+    }
+
+    /// Wakes a sleeping body and its whole sleeping island.
+    pub(crate) fn wake_body(&mut self, body_index: u32) {
+        let Some(b) = self.bodies.at(body_index) else { return };
+        if b.body_type == BodyType::Static {
+            return;
+        }
+        if b.awake {
+            if let Some(b) = self.bodies.at_mut(body_index) {
+                b.sleep_time = 0.0;
+            }
+            return;
+        }
+        let island = b.sleep_island;
+        let members = self
+            .sleep_islands
+            .get_mut(island as usize)
+            .and_then(|s| s.take())
+            .unwrap_or_else(|| vec![body_index]);
+        if (island as usize) < self.sleep_islands.len() {
+            self.island_free.push(island);
+        }
+        for m in members {
+            if let Some(b) = self.bodies.at_mut(m) {
+                b.awake = true;
+                b.sleep_time = 0.0;
+                b.sleep_island = u32::MAX;
+            }
+        }
+    }
+
+    fn wake_all(&mut self) {
+        let ids: Vec<u32> = self.bodies.iter().map(|(i, _)| i).collect();
+        for i in ids {
+            self.wake_body(i);
+        }
+    }
+
+    /// Puts the listed bodies to sleep as one island.
+    pub(crate) fn put_to_sleep(&mut self, members: &[u32]) {
+        let island = match self.island_free.pop() {
+            Some(i) => i,
+            None => {
+                self.sleep_islands.push(None);
+                (self.sleep_islands.len() - 1) as u32
+            }
+        };
+        for &m in members {
+            if let Some(b) = self.bodies.at_mut(m) {
+                b.awake = false;
+                b.sleep_time = 0.0;
+                b.v = Vec2::ZERO;
+                b.w = 0.0;
+                b.sleep_island = island;
+            }
+        }
+        self.sleep_islands[island as usize] = Some(members.to_vec());
+    }
+
+    /// The awake dynamic bodies connected to `body_index` through touching contacts.
+    fn island_of(&self, body_index: u32) -> Vec<u32> {
+        let mut out = vec![body_index];
+        let mut seen = std::collections::BTreeSet::from([body_index]);
+        let mut i = 0;
+        while i < out.len() {
+            if let Some(b) = self.bodies.at(out[i]) {
+                for &ci in &b.contacts {
+                    if let Some(Some(c)) = self.contacts.get(ci as usize) {
+                        if !c.touching {
+                            continue;
+                        }
+                        let other = if c.body_a == out[i] { c.body_b } else { c.body_a };
+                        let dynamic = self.bodies.at(other).is_some_and(|o| o.is_dynamic());
+                        if dynamic && seen.insert(other) {
+                            out.push(other);
+                        }
+                    }
+                }
+            }
+            i += 1;
+        }
+        out.sort_unstable();
+        out
+    }
+
+    /// Removes a contact record; reports an end event if it was touching.
+    pub(crate) fn destroy_contact(&mut self, ci: u32, wake: bool) {
+        let Some(slot) = self.contacts.get_mut(ci as usize) else {
+            return;
+        };
+        let Some(c) = slot.take() else { return };
+        self.contact_free.push(ci);
+        self.broad_phase
+            .pairs
+            .remove(&crate::collision::contact::pair_key(c.shape_a.index, c.shape_b.index));
+        for bi in [c.body_a, c.body_b] {
+            if let Some(b) = self.bodies.at_mut(bi) {
+                if let Some(pos) = b.contacts.iter().position(|&x| x == ci) {
+                    b.contacts.swap_remove(pos);
+                }
+            }
+        }
+        if c.touching {
+            self.events.end.push(ContactEndEvent {
+                shape_a: c.shape_a,
+                shape_b: c.shape_b,
+            });
+            if wake {
+                self.wake_body(c.body_a);
+                self.wake_body(c.body_b);
+            }
+        }
+    }
+}
+
+/// The box a shape needs in the broad phase: its tight box grown by the speculative
+/// distance and swept along `v·dt` (so a fast body's pairs exist before it gets there).
+pub(crate) fn shape_box(geometry: &Shape, xf: Transform, v: Vec2, dt: f32) -> Aabb {
+    let aabb = geometry.aabb(xf).expand(SPECULATIVE_DISTANCE);
+    if dt > 0.0 {
+        let d = v * dt;
+        aabb.union(Aabb::new(aabb.min + d, aabb.max + d))
+    } else {
+        aabb
+    }
+}
+
+/// Shapes built through the public constructors are valid; shapes built by hand (struct
+/// literals of the public fields) are checked here.
+fn validate_geometry(g: &Shape) -> Result<()> {
+    match g {
+        Shape::Circle(c) => {
+            check_vec("Circle::center", c.center)?;
+            check_positive("Circle::radius", c.radius)?;
+        }
+        Shape::Capsule(c) => {
+            check_vec("Capsule::center1", c.center1)?;
+            check_vec("Capsule::center2", c.center2)?;
+            check_positive("Capsule::radius", c.radius)?;
+            if (c.center2 - c.center1).length() < crate::geometry::LINEAR_SLOP {
+                return Err(Error::arg("Capsule", "center1 and center2 coincide (use a circle)"));
+            }
+        }
+        Shape::Segment(s) => {
+            check_vec("Segment::point1", s.point1)?;
+            check_vec("Segment::point2", s.point2)?;
+            if (s.point2 - s.point1).length() < crate::geometry::LINEAR_SLOP {
+                return Err(Error::arg("Segment", "point1 and point2 coincide"));
+            }
+        }
+        Shape::Polygon(p) => {
+            // Polygons can only be built through validated constructors.
+            let _ = p;
+        }
+    }
+    let _ = Rot::IDENTITY;
+    Ok(())
+}

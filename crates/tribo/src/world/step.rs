@@ -1,0 +1,448 @@
+//! `World::step`: the table of contents of a step, and its phases.
+//!
+//! 1. [`World::update_pairs`]: broad phase; moved proxies find new pairs → contacts.
+//! 2. [`World::collide`]: narrow phase; manifolds, begin/end events, waking.
+//! 3. [`World::solve`]: solver stages (see [`crate::solver`]), impulses stored back.
+//! 4. [`World::finalize`]: poses from the solver, swept fat boxes, sleep timers.
+//! 5. [`World::update_sleep`]: islands that rested long enough fall asleep.
+
+use super::{ContactBeginEvent, ContactEndEvent, World};
+use crate::collision::broad_phase::{MOVING_TREE, STATIC_TREE};
+use crate::collision::contact::{pair_key, Contact, PointState};
+use crate::dynamics::{mix, BodyType};
+use crate::error::{Error, Result};
+use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
+use crate::math::{Rot, Vec2};
+use crate::solver::contact_solver::{store_impulses, ConstraintBodies};
+use crate::solver::{solve_step, BodySim, BodyState, Softness, StepContext};
+use crate::world::BodyId;
+
+impl World {
+    /// Advances the world by `dt` [s] (usually 1/60) in `WorldDef::substeps` substeps.
+    /// `dt = 0` does nothing. Contact events of the step are read afterwards with
+    /// [`World::contact_events`].
+    pub fn step(&mut self, dt: f32) -> Result<()> {
+        if !dt.is_finite() || dt < 0.0 {
+            return Err(Error::arg("dt", format!("must be finite and ≥ 0 (got {dt})")));
+        }
+        self.events.begin.clear();
+        self.events.end.clear();
+        self.non_finite.clear();
+        if dt == 0.0 {
+            return Ok(());
+        }
+        self.update_pairs();
+        self.collide(dt);
+        let ctx = self.step_context(dt);
+        self.solve(&ctx);
+        self.finalize(dt);
+        self.update_sleep(dt);
+        self.step_count += 1;
+        Ok(())
+    }
+
+    fn step_context(&self, dt: f32) -> StepContext {
+        let substeps = self.def.substeps.max(1);
+        let h = dt / substeps as f32;
+        // Box2D v3 clamps the contact frequency to 1/8 of the substep rate.
+        let hertz = self.def.contact_hertz.min(0.125 / h);
+        let zeta = self.def.contact_damping_ratio;
+        StepContext {
+            dt,
+            h,
+            inv_h: 1.0 / h,
+            substeps,
+            contact_softness: Softness::new(hertz, zeta, h),
+            static_softness: Softness::new(2.0 * hertz, zeta, h),
+            contact_hertz: hertz,
+            contact_damping_ratio: zeta,
+            push_speed: self.def.contact_push_speed,
+            max_deflection: self.def.max_contact_deflection,
+            stick_speed: self.def.stick_speed,
+            max_linear_speed: self.def.max_linear_speed,
+            warm_starting: self.def.warm_starting,
+        }
+    }
+
+    /// Broad phase: query the trees with every moved proxy and create contacts for new
+    /// pairs, in sorted pair order (deterministic).
+    fn update_pairs(&mut self) {
+        let mut moved = core::mem::take(&mut self.broad_phase.moved);
+        moved.sort_unstable();
+        moved.dedup();
+        for &si in &moved {
+            if let Some(s) = self.shapes.at_mut(si) {
+                s.moved = true;
+            }
+        }
+        let mut new_pairs: Vec<u64> = Vec::new();
+        for &si in &moved {
+            let Some(s) = self.shapes.at(si) else { continue };
+            let trees: &[u8] = if s.tree == STATIC_TREE {
+                &[MOVING_TREE]
+            } else {
+                &[MOVING_TREE, STATIC_TREE]
+            };
+            for &tree in trees {
+                self.broad_phase.trees[tree as usize].query(s.fat_aabb, s.filter.mask, |_, data| {
+                    let other = data as u32;
+                    if other != si {
+                        if let Some(o) = self.shapes.at(other) {
+                            // When both moved, the lower index reports the pair.
+                            if !(o.moved && other < si) && self.pair_allowed(si, other) {
+                                new_pairs.push(pair_key(si, other));
+                            }
+                        }
+                    }
+                    true
+                });
+            }
+        }
+        for &si in &moved {
+            if let Some(s) = self.shapes.at_mut(si) {
+                s.moved = false;
+            }
+        }
+        moved.clear();
+        self.broad_phase.moved = moved;
+        new_pairs.sort_unstable();
+        new_pairs.dedup();
+        for key in new_pairs {
+            self.create_contact((key >> 32) as u32, key as u32);
+        }
+    }
+
+    /// Whether two shapes may form a contact: different bodies, at least one dynamic,
+    /// filters agree, no contact yet.
+    fn pair_allowed(&self, sa: u32, sb: u32) -> bool {
+        let (Some(a), Some(b)) = (self.shapes.at(sa), self.shapes.at(sb)) else {
+            return false;
+        };
+        if a.body == b.body {
+            return false;
+        }
+        let (Some(ba), Some(bb)) = (self.bodies.at(a.body.index), self.bodies.at(b.body.index)) else {
+            return false;
+        };
+        if !ba.is_dynamic() && !bb.is_dynamic() {
+            return false;
+        }
+        if !a.filter.should_collide(&b.filter) {
+            return false;
+        }
+        !self.broad_phase.pairs.contains_key(&pair_key(sa, sb))
+    }
+
+    fn create_contact(&mut self, sa: u32, sb: u32) {
+        let (Some(a), Some(b)) = (self.shapes.at(sa), self.shapes.at(sb)) else {
+            return;
+        };
+        let contact = Contact {
+            shape_a: super::ShapeId {
+                index: sa,
+                generation: self.shapes.generation(sa),
+            },
+            shape_b: super::ShapeId {
+                index: sb,
+                generation: self.shapes.generation(sb),
+            },
+            body_a: a.body.index,
+            body_b: b.body.index,
+            manifold: Manifold::default(),
+            points: [PointState::default(); 2],
+            material: mix(&a.material, &b.material),
+            rolling_radius: rolling_radius(&a.geometry).max(rolling_radius(&b.geometry)),
+            rolling_impulse: 0.0,
+            touching: false,
+        };
+        let (body_a, body_b) = (contact.body_a, contact.body_b);
+        let ci = match self.contact_free.pop() {
+            Some(i) => {
+                self.contacts[i as usize] = Some(contact);
+                i
+            }
+            None => {
+                self.contacts.push(Some(contact));
+                (self.contacts.len() - 1) as u32
+            }
+        };
+        self.broad_phase.pairs.insert(pair_key(sa, sb), ci);
+        for bi in [body_a, body_b] {
+            if let Some(b) = self.bodies.at_mut(bi) {
+                b.contacts.push(ci);
+            }
+        }
+    }
+
+    /// Narrow phase: update the manifold of every contact with an awake moving body;
+    /// destroy contacts whose fat boxes separated; report begin/end; wake sleepers.
+    fn collide(&mut self, dt: f32) {
+        let mut to_destroy = Vec::new();
+        let mut to_wake = Vec::new();
+        for ci in 0..self.contacts.len() {
+            let Some(c) = self.contacts[ci].as_mut() else { continue };
+            let (Some(ba), Some(bb)) = (self.bodies.at(c.body_a), self.bodies.at(c.body_b)) else {
+                continue;
+            };
+            let active_a = ba.awake && ba.body_type != BodyType::Static;
+            let active_b = bb.awake && bb.body_type != BodyType::Static;
+            if !active_a && !active_b {
+                continue;
+            }
+            let (Some(sa), Some(sb)) = (
+                self.shapes.get(c.shape_a.index, c.shape_a.generation),
+                self.shapes.get(c.shape_b.index, c.shape_b.generation),
+            ) else {
+                continue;
+            };
+            if !sa.fat_aabb.overlaps(sb.fat_aabb) || !sa.filter.should_collide(&sb.filter) {
+                to_destroy.push(ci as u32);
+                continue;
+            }
+            // Speculative margin grows with the relative motion of the step, so fast
+            // bodies meet thin ground before they can pass it.
+            let rel = (bb.v - ba.v).length() + ba.w.abs() * ba.max_extent + bb.w.abs() * bb.max_extent;
+            let margin = SPECULATIVE_DISTANCE + dt * rel;
+            let was = c.touching;
+            let now = c.update(&sa.geometry, ba.xf, &sb.geometry, bb.xf, margin);
+            if now && !was {
+                self.events.begin.push(ContactBeginEvent {
+                    shape_a: c.shape_a,
+                    shape_b: c.shape_b,
+                    normal: c.manifold.normal,
+                    point: c.manifold.points[0].point,
+                });
+                if !ba.awake {
+                    to_wake.push(c.body_a);
+                }
+                if !bb.awake {
+                    to_wake.push(c.body_b);
+                }
+            } else if was && !now {
+                self.events.end.push(ContactEndEvent {
+                    shape_a: c.shape_a,
+                    shape_b: c.shape_b,
+                });
+            }
+        }
+        for ci in to_destroy {
+            self.destroy_contact(ci, false);
+        }
+        for bi in to_wake {
+            self.wake_body(bi);
+        }
+    }
+
+    /// Builds the solver arrays from the awake bodies and touching contacts, runs the
+    /// solver stages and stores impulses back into the contacts.
+    fn solve(&mut self, ctx: &StepContext) {
+        let g = self.def.gravity;
+        self.states.clear();
+        self.sims.clear();
+        self.states.push(BodyState::default()); // index 0: every static body
+        self.sims.push(BodySim::default());
+        let capacity = self.bodies.capacity();
+        for bi in 0..capacity as u32 {
+            let Some(b) = self.bodies.at_mut(bi) else { continue };
+            if !b.awake || b.body_type == BodyType::Static {
+                b.solver_index = 0;
+                continue;
+            }
+            b.solver_index = self.states.len() as u32;
+            self.states.push(BodyState {
+                v: b.v,
+                w: b.w,
+                _pad: 0.0,
+                dp: Vec2::ZERO,
+                dq: Rot::IDENTITY,
+            });
+            let dynamic = b.body_type == BodyType::Dynamic;
+            let force = b.force + b.constant_force;
+            let torque = b.torque + b.constant_torque;
+            self.sims.push(BodySim {
+                inv_mass: b.inv_mass,
+                inv_inertia: b.inv_inertia,
+                linear_accel: if dynamic {
+                    b.inv_mass * force + b.gravity_scale * g
+                } else {
+                    Vec2::ZERO
+                },
+                angular_accel: if dynamic { b.inv_inertia * torque } else { 0.0 },
+                linear_damping: if dynamic { b.linear_damping } else { 0.0 },
+                angular_damping: if dynamic { b.angular_damping } else { 0.0 },
+                body: bi,
+            });
+        }
+        // Constraints: contacts between two moving bodies first, then contacts with static
+        // bodies, so the ground has the last word in each pass (as Box2D's colouring does).
+        let mut solver = core::mem::take(&mut self.contact_solver);
+        solver.constraints.clear();
+        for pass_static in [false, true] {
+            for (ci, slot) in self.contacts.iter().enumerate() {
+                let Some(c) = slot else { continue };
+                if !c.touching {
+                    continue;
+                }
+                let (Some(ba), Some(bb)) = (self.bodies.at(c.body_a), self.bodies.at(c.body_b)) else {
+                    continue;
+                };
+                let awake_dynamic = (ba.awake && ba.is_dynamic()) || (bb.awake && bb.is_dynamic());
+                if !awake_dynamic {
+                    continue;
+                }
+                let has_static = ba.solver_index == 0 || bb.solver_index == 0;
+                if has_static != pass_static {
+                    continue;
+                }
+                let bodies = ConstraintBodies {
+                    index_a: ba.solver_index,
+                    index_b: bb.solver_index,
+                    inv_mass_a: if ba.solver_index == 0 { 0.0 } else { ba.inv_mass },
+                    inv_i_a: if ba.solver_index == 0 { 0.0 } else { ba.inv_inertia },
+                    inv_mass_b: if bb.solver_index == 0 { 0.0 } else { bb.inv_mass },
+                    inv_i_b: if bb.solver_index == 0 { 0.0 } else { bb.inv_inertia },
+                    center_a: ba.center,
+                    center_b: bb.center,
+                };
+                solver.push(ci as u32, c, &bodies);
+            }
+        }
+        solve_step(ctx, &self.sims, &mut self.states, &mut solver);
+        for cc in &solver.constraints {
+            if let Some(Some(c)) = self.contacts.get_mut(cc.contact as usize) {
+                store_impulses(cc, c, &self.states, ctx);
+            }
+        }
+        self.contact_solver = solver;
+    }
+
+    /// Writes the solver's motion back to the bodies, refreshes fat boxes and sleep timers.
+    fn finalize(&mut self, dt: f32) {
+        for k in 1..self.states.len() {
+            let s = self.states[k];
+            let bi = self.sims[k].body;
+            let Some(b) = self.bodies.at_mut(bi) else { continue };
+            b.force = Vec2::ZERO;
+            b.torque = 0.0;
+            let finite =
+                s.v.is_finite() && s.w.is_finite() && s.dp.is_finite() && s.dq.c.is_finite() && s.dq.s.is_finite();
+            if !finite {
+                // NaN born inside the simulation: freeze the body at its last good pose
+                // and report it rather than spreading the NaN.
+                b.v = Vec2::ZERO;
+                b.w = 0.0;
+                let id = BodyId {
+                    index: bi,
+                    generation: self.bodies.generation(bi),
+                };
+                self.non_finite.push(id);
+                continue;
+            }
+            b.v = s.v;
+            b.w = s.w;
+            b.center0 = b.center;
+            b.center += s.dp;
+            let q = s.dq.mul(b.xf.q);
+            // Renormalise against slow drift of |q| over many steps.
+            let mag = (q.c * q.c + q.s * q.s).sqrt();
+            b.xf.q = Rot {
+                c: q.c / mag,
+                s: q.s / mag,
+            };
+            b.xf.p = b.center - b.xf.q.rotate(b.local_center);
+            // Sleep timer (Box2D's metric: |v| + |ω|·extent against the threshold).
+            if self.def.enable_sleep && b.enable_sleep && b.body_type == BodyType::Dynamic {
+                let speed = b.v.length() + b.w.abs() * b.max_extent;
+                if speed > b.sleep_threshold {
+                    b.sleep_time = 0.0;
+                } else {
+                    b.sleep_time += dt;
+                }
+            } else {
+                b.sleep_time = 0.0;
+            }
+            self.refresh_body_proxies(bi, dt);
+        }
+    }
+
+    /// Islands (awake dynamic bodies linked by touching contacts) whose every body has
+    /// rested for `time_to_sleep` fall asleep together.
+    fn update_sleep(&mut self, _dt: f32) {
+        if !self.def.enable_sleep {
+            return;
+        }
+        let n = self.bodies.capacity();
+        let mut parent = core::mem::take(&mut self.scratch_u32);
+        parent.clear();
+        parent.extend(0..n as u32);
+        fn find(p: &mut [u32], mut x: u32) -> u32 {
+            while p[x as usize] != x {
+                let gp = p[p[x as usize] as usize];
+                p[x as usize] = gp;
+                x = gp;
+            }
+            x
+        }
+        for c in self.contacts.iter().flatten() {
+            if !c.touching {
+                continue;
+            }
+            let (Some(a), Some(b)) = (self.bodies.at(c.body_a), self.bodies.at(c.body_b)) else {
+                continue;
+            };
+            if a.is_dynamic() && b.is_dynamic() && a.awake && b.awake {
+                let (ra, rb) = (find(&mut parent, c.body_a), find(&mut parent, c.body_b));
+                if ra != rb {
+                    // Union by smaller index: deterministic roots.
+                    let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+                    parent[hi as usize] = lo;
+                }
+            }
+        }
+        let mut min_time = core::mem::take(&mut self.scratch_f32);
+        min_time.clear();
+        min_time.resize(n, f32::INFINITY);
+        let mut any = false;
+        for (bi, b) in self.bodies.iter() {
+            if b.awake && b.is_dynamic() {
+                let r = find(&mut parent, bi) as usize;
+                min_time[r] = min_time[r].min(b.sleep_time);
+                any = true;
+            }
+        }
+        if any {
+            let mut islands: Vec<(u32, Vec<u32>)> = Vec::new();
+            let tts = self.def.time_to_sleep;
+            let mut members_of_root: std::collections::BTreeMap<u32, Vec<u32>> = Default::default();
+            for (bi, b) in self.bodies.iter() {
+                if b.awake && b.is_dynamic() {
+                    let r = find(&mut parent, bi);
+                    if min_time[r as usize] >= tts {
+                        members_of_root.entry(r).or_default().push(bi);
+                    }
+                }
+            }
+            islands.extend(members_of_root);
+            for (_, members) in islands {
+                self.put_to_sleep(&members);
+            }
+        }
+        self.scratch_u32 = parent;
+        self.scratch_f32 = min_time;
+    }
+
+    /// Bodies frozen in the last step because their state became non-finite.
+    pub fn non_finite_bodies(&self) -> &[BodyId] {
+        &self.non_finite
+    }
+}
+
+/// Lever arm of rolling resistance [m]: the rounding radius of a shape.
+fn rolling_radius(g: &Shape) -> f32 {
+    match g {
+        Shape::Circle(c) => c.radius,
+        Shape::Capsule(c) => c.radius,
+        Shape::Polygon(p) => p.radius(),
+        Shape::Segment(_) => 0.0,
+    }
+}

@@ -1,0 +1,507 @@
+//! Public-API behaviour: bad input is rejected with an error and changes nothing, stale ids
+//! are caught, events and queries report what happened, sleeping works, runs are
+//! deterministic.
+
+use tribo::{
+    Aabb, BodyDef, BodyType, Capsule, Circle, Error, Filter, Material, Polygon, QueryFilter, Segment, Shape, ShapeDef,
+    Vec2, World, WorldDef,
+};
+
+const DT: f32 = 1.0 / 60.0;
+
+fn ground(world: &mut World) -> tribo::BodyId {
+    let g = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
+    world
+        .create_shape(
+            g,
+            &ShapeDef::default(),
+            &Shape::Polygon(Polygon::new_box(50.0, 1.0).unwrap()),
+        )
+        .unwrap();
+    g
+}
+
+fn unit_box() -> Shape {
+    Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap())
+}
+
+/// A snapshot of every body's state, for "nothing changed" and determinism checks.
+fn snapshot(world: &World) -> Vec<[u32; 6]> {
+    world
+        .body_ids()
+        .into_iter()
+        .map(|b| {
+            let p = world.body_position(b).unwrap();
+            let v = world.body_linear_velocity(b).unwrap();
+            [
+                p.x.to_bits(),
+                p.y.to_bits(),
+                world.body_angle(b).unwrap().to_bits(),
+                v.x.to_bits(),
+                v.y.to_bits(),
+                world.body_angular_velocity(b).unwrap().to_bits(),
+            ]
+        })
+        .collect()
+}
+
+fn busy_world() -> (World, tribo::BodyId) {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    ground(&mut world);
+    let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 0.5))).unwrap();
+    world.create_shape(b, &ShapeDef::default(), &unit_box()).unwrap();
+    for _ in 0..10 {
+        world.step(DT).unwrap();
+    }
+    (world, b)
+}
+
+#[test]
+fn non_finite_and_out_of_range_input_is_rejected_and_changes_nothing() {
+    let (mut world, b) = busy_world();
+    let before = snapshot(&world);
+    let (bodies, shapes) = (world.body_count(), world.shape_count());
+    let nan = f32::NAN;
+    let inf = f32::INFINITY;
+    let bad_vec = [Vec2::new(nan, 0.0), Vec2::new(0.0, inf), Vec2::new(-inf, 1.0)];
+
+    for v in bad_vec {
+        assert!(world.create_body(&BodyDef::dynamic(v)).is_err());
+        assert!(world.set_body_transform(b, v, 0.0).is_err());
+        assert!(world.set_body_linear_velocity(b, v).is_err());
+        assert!(world.apply_force(b, v, Vec2::ZERO, true).is_err());
+        assert!(world.apply_force(b, Vec2::X, v, true).is_err());
+        assert!(world.apply_linear_impulse(b, v, Vec2::ZERO, true).is_err());
+        assert!(world.apply_linear_impulse_to_center(b, v, true).is_err());
+        assert!(world.apply_force_to_center(b, v, true).is_err());
+        assert!(world.set_body_constant_force(b, v).is_err());
+        assert!(world.set_gravity(v).is_err());
+        assert!(world.cast_ray_closest(v, Vec2::X, QueryFilter::default()).is_err());
+        assert!(world.body_velocity_at_point(b, v).is_err());
+    }
+    for x in [nan, inf, -inf] {
+        assert!(world.set_body_transform(b, Vec2::ZERO, x).is_err());
+        assert!(world.set_body_angular_velocity(b, x).is_err());
+        assert!(world.apply_torque(b, x, true).is_err());
+        assert!(world.apply_angular_impulse(b, x, true).is_err());
+        assert!(world.set_body_gravity_scale(b, x).is_err());
+        assert!(world.set_body_constant_torque(b, x).is_err());
+        assert!(world.step(x).is_err());
+        let def = BodyDef {
+            angle: x,
+            ..BodyDef::dynamic(Vec2::ZERO)
+        };
+        assert!(world.create_body(&def).is_err());
+        // Materials
+        for m in [
+            Material::default().density(x),
+            Material::default().friction(x, 0.1),
+            Material::default().restitution(x),
+            Material {
+                tangent_speed: x,
+                ..Material::default()
+            },
+        ] {
+            assert!(world.create_shape(b, &ShapeDef::with_material(m), &unit_box()).is_err());
+        }
+        // Geometry constructors
+        assert!(Circle::new(Vec2::ZERO, x).is_err());
+        assert!(Polygon::new_box(x, 1.0).is_err());
+        assert!(Capsule::new(Vec2::ZERO, Vec2::new(x, 0.0), 0.1).is_err());
+        assert!(Segment::new(Vec2::ZERO, Vec2::new(0.0, x)).is_err());
+        assert!(Polygon::from_points(&[Vec2::ZERO, Vec2::X, Vec2::new(x, 1.0)], 0.0).is_err());
+    }
+    assert!(world.step(-1.0).is_err());
+    assert!(world.set_body_damping(b, -1.0, 0.0).is_err());
+    assert!(world
+        .overlap_aabb(Aabb::new(Vec2::new(1.0, 1.0), Vec2::ZERO), QueryFilter::default())
+        .is_err());
+    // Negative and zero sizes.
+    assert!(Circle::new(Vec2::ZERO, -1.0).is_err());
+    assert!(Circle::new(Vec2::ZERO, 0.0).is_err());
+    assert!(Polygon::new_box(-1.0, 1.0).is_err());
+    assert!(Polygon::new_box(1.0, 0.0).is_err());
+    assert!(Capsule::new(Vec2::ZERO, Vec2::X, -0.5).is_err());
+    // A hand-built shape with a bad radius is caught by create_shape.
+    let bad = Shape::Circle(Circle {
+        center: Vec2::ZERO,
+        radius: -2.0,
+    });
+    assert!(world.create_shape(b, &ShapeDef::default(), &bad).is_err());
+    // μs < μd, e > 1, negative density.
+    for m in [
+        Material::default().friction(0.2, 0.5),
+        Material::default().restitution(1.2),
+        Material::default().density(-1.0),
+    ] {
+        let err = world
+            .create_shape(b, &ShapeDef::with_material(m), &unit_box())
+            .unwrap_err();
+        assert!(!err.to_string().is_empty());
+    }
+    // World settings.
+    assert!(World::new(WorldDef {
+        substeps: 0,
+        ..WorldDef::default()
+    })
+    .is_err());
+    assert!(world
+        .set_def(WorldDef {
+            contact_hertz: nan,
+            ..WorldDef::default()
+        })
+        .is_err());
+
+    assert_eq!(snapshot(&world), before, "a rejected call changed the world");
+    assert_eq!((world.body_count(), world.shape_count()), (bodies, shapes));
+}
+
+#[test]
+fn errors_say_what_is_wrong() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let err = world
+        .create_body(&BodyDef::dynamic(Vec2::new(f32::NAN, 0.0)))
+        .unwrap_err();
+    assert!(err.to_string().contains("BodyDef::position"), "{err}");
+    let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    let err = world
+        .create_shape(
+            b,
+            &ShapeDef::with_material(Material::default().friction(0.2, 0.5)),
+            &unit_box(),
+        )
+        .unwrap_err();
+    assert!(err.to_string().contains("static friction"), "{err}");
+    let err = Polygon::from_points(&[Vec2::ZERO, Vec2::X, Vec2::new(2.0, 0.0)], 0.0).unwrap_err();
+    assert!(
+        err.to_string().contains("collinear") || err.to_string().contains("degenerate"),
+        "{err}"
+    );
+}
+
+#[test]
+fn stale_ids_give_errors_never_another_body() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    ground(&mut world);
+    let a = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 2.0))).unwrap();
+    let sa = world.create_shape(a, &ShapeDef::default(), &unit_box()).unwrap();
+    world.step(DT).unwrap();
+    world.destroy_body(a).unwrap();
+    // The slot is reused by a new body; the old id must not reach it.
+    let b = world.create_body(&BodyDef::dynamic(Vec2::new(5.0, 2.0))).unwrap();
+    assert_eq!(a.index, b.index);
+    assert_eq!(world.body_position(a), Err(Error::InvalidBody(a)));
+    assert_eq!(world.destroy_body(a), Err(Error::InvalidBody(a)));
+    assert!(world.set_body_linear_velocity(a, Vec2::X).is_err());
+    assert!(world.apply_force_to_center(a, Vec2::X, true).is_err());
+    assert!(world.create_shape(a, &ShapeDef::default(), &unit_box()).is_err());
+    assert_eq!(world.shape_body(sa), Err(Error::InvalidShape(sa)));
+    assert!(world.destroy_shape(sa).is_err());
+    assert_eq!(world.body_position(b).unwrap(), Vec2::new(5.0, 2.0));
+    world.step(DT).unwrap();
+}
+
+#[test]
+fn create_and_destroy_between_steps() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    ground(&mut world);
+    let mut live = Vec::new();
+    for i in 0..200 {
+        if i % 3 == 0 && !live.is_empty() {
+            let b = live.remove((i * 7) % live.len());
+            world.destroy_body(b).unwrap();
+        }
+        let b = world
+            .create_body(&BodyDef::dynamic(Vec2::new((i % 10) as f32, 1.0 + (i % 5) as f32)))
+            .unwrap();
+        let shape = match i % 4 {
+            0 => unit_box(),
+            1 => Shape::Circle(Circle::new(Vec2::ZERO, 0.3).unwrap()),
+            2 => Shape::Capsule(Capsule::new(Vec2::new(-0.3, 0.0), Vec2::new(0.3, 0.0), 0.2).unwrap()),
+            _ => Shape::Polygon(
+                Polygon::from_points(&[Vec2::new(0.0, 0.0), Vec2::new(0.6, 0.1), Vec2::new(0.2, 0.5)], 0.02).unwrap(),
+            ),
+        };
+        let s = world.create_shape(b, &ShapeDef::default(), &shape).unwrap();
+        if i % 5 == 0 {
+            world.destroy_shape(s).unwrap();
+            world.create_shape(b, &ShapeDef::default(), &unit_box()).unwrap();
+        }
+        live.push(b);
+        world.step(DT).unwrap();
+    }
+    for &b in &live {
+        assert!(world.body_position(b).unwrap().is_finite());
+        assert!(world.body_position(b).unwrap().y > -0.1, "body fell through the ground");
+    }
+    assert_eq!(world.body_count(), live.len() + 1);
+}
+
+#[test]
+fn mass_properties_come_from_shapes() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    let m = Material::default().density(2.0);
+    // Box 2 × 1 at density 2: m = 4 kg, I = m (w² + h²) / 12 = 4·5/12.
+    world
+        .create_shape(
+            b,
+            &ShapeDef::with_material(m),
+            &Shape::Polygon(Polygon::new_box(1.0, 0.5).unwrap()),
+        )
+        .unwrap();
+    assert!((world.body_mass(b).unwrap() - 4.0).abs() < 1e-5);
+    assert!((world.body_rotational_inertia(b).unwrap() - 4.0 * 5.0 / 12.0).abs() < 1e-4);
+    // Add a disk of radius 0.5 at (2, 0): centre of mass moves toward it.
+    world
+        .create_shape(
+            b,
+            &ShapeDef::with_material(m),
+            &Shape::Circle(Circle::new(Vec2::new(2.0, 0.0), 0.5).unwrap()),
+        )
+        .unwrap();
+    let md = 2.0 * core::f32::consts::PI * 0.25;
+    let expected_cx = md * 2.0 / (4.0 + md);
+    assert!((world.body_local_center_of_mass(b).unwrap().x - expected_cx).abs() < 1e-4);
+    world.set_body_fixed_rotation(b, true).unwrap();
+    assert_eq!(world.body_rotational_inertia(b).unwrap(), 0.0);
+}
+
+#[test]
+fn begin_and_end_events() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    ground(&mut world);
+    let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 1.0))).unwrap();
+    world.create_shape(b, &ShapeDef::default(), &unit_box()).unwrap();
+    let mut began = 0;
+    for _ in 0..60 {
+        world.step(DT).unwrap();
+        began += world.contact_events().begin.len();
+    }
+    assert_eq!(began, 1);
+    assert_eq!(world.body_contacts(b).unwrap().len(), 1);
+    // Throw it upward: the contact ends.
+    world.set_body_linear_velocity(b, Vec2::new(0.0, 8.0)).unwrap();
+    let mut ended = 0;
+    for _ in 0..10 {
+        world.step(DT).unwrap();
+        ended += world.contact_events().end.len();
+    }
+    assert_eq!(ended, 1);
+}
+
+#[test]
+fn ray_cast_and_overlap_queries() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let g = ground(&mut world);
+    let b = world.create_body(&BodyDef::dynamic(Vec2::new(3.0, 0.5))).unwrap();
+    let sb = world.create_shape(b, &ShapeDef::default(), &unit_box()).unwrap();
+    // Straight down onto the box top at y = 1.
+    let hit = world
+        .cast_ray_closest(Vec2::new(3.0, 5.0), Vec2::new(0.0, -10.0), QueryFilter::default())
+        .unwrap()
+        .expect("hit");
+    assert_eq!(hit.shape, sb);
+    assert!((hit.point.y - 1.0).abs() < 1e-4);
+    assert!((hit.fraction - 0.4).abs() < 1e-4);
+    assert!((hit.normal - Vec2::Y).length() < 1e-4);
+    // Beside the box: the ground (top at y = 0).
+    let hit = world
+        .cast_ray_closest(Vec2::new(-3.0, 5.0), Vec2::new(0.0, -10.0), QueryFilter::default())
+        .unwrap()
+        .expect("hit");
+    assert_eq!(hit.body, g);
+    assert!(hit.point.y.abs() < 1e-4);
+    // Filter out the ground's category.
+    let none = world
+        .cast_ray_closest(
+            Vec2::new(-3.0, 5.0),
+            Vec2::new(0.0, -10.0),
+            QueryFilter { category: 1, mask: 0 },
+        )
+        .unwrap();
+    assert!(none.is_none());
+    let found = world
+        .overlap_aabb(
+            Aabb::new(Vec2::new(2.9, 0.9), Vec2::new(3.1, 1.1)),
+            QueryFilter::default(),
+        )
+        .unwrap();
+    assert!(found.contains(&sb));
+}
+
+#[test]
+fn collision_filtering() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    ground(&mut world);
+    let ghost = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 2.0))).unwrap();
+    let def = ShapeDef {
+        filter: Filter {
+            category: 2,
+            mask: !1,
+            group: 0,
+        },
+        ..ShapeDef::default()
+    };
+    world.create_shape(ghost, &def, &unit_box()).unwrap();
+    for _ in 0..60 {
+        world.step(DT).unwrap();
+    }
+    assert!(
+        world.body_position(ghost).unwrap().y < -1.0,
+        "masked body should fall through the ground"
+    );
+    // Negative group: two boxes of group -1 pass through each other.
+    let mut world = World::new(WorldDef {
+        gravity: Vec2::ZERO,
+        ..WorldDef::default()
+    })
+    .unwrap();
+    let def = ShapeDef {
+        filter: Filter {
+            group: -1,
+            ..Filter::default()
+        },
+        ..ShapeDef::default()
+    };
+    let a = world.create_body(&BodyDef::dynamic(Vec2::new(-2.0, 0.0))).unwrap();
+    world.create_shape(a, &def, &unit_box()).unwrap();
+    world.set_body_linear_velocity(a, Vec2::new(4.0, 0.0)).unwrap();
+    let b = world.create_body(&BodyDef::dynamic(Vec2::new(2.0, 0.0))).unwrap();
+    world.create_shape(b, &def, &unit_box()).unwrap();
+    for _ in 0..60 {
+        world.step(DT).unwrap();
+    }
+    assert!(world.body_position(a).unwrap().x > 1.5);
+}
+
+#[test]
+fn bodies_sleep_at_rest_and_wake_when_touched() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    ground(&mut world);
+    let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 0.5))).unwrap();
+    world.create_shape(b, &ShapeDef::default(), &unit_box()).unwrap();
+    for _ in 0..120 {
+        world.step(DT).unwrap();
+    }
+    assert!(!world.body_is_awake(b).unwrap(), "resting box should sleep after 0.5 s");
+    let y_sleep = world.body_position(b).unwrap().y;
+    // Drop a box on it: it wakes.
+    let c = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 3.0))).unwrap();
+    world.create_shape(c, &ShapeDef::default(), &unit_box()).unwrap();
+    let mut woke = false;
+    for _ in 0..60 {
+        world.step(DT).unwrap();
+        woke |= world.body_is_awake(b).unwrap();
+    }
+    assert!(woke, "sleeping box should wake when hit");
+    assert!((world.body_position(c).unwrap().y - 1.5).abs() < 0.02);
+    assert!((world.body_position(b).unwrap().y - y_sleep).abs() < 0.01);
+    // Applying an impulse wakes a sleeper.
+    for _ in 0..120 {
+        world.step(DT).unwrap();
+    }
+    assert!(!world.body_is_awake(c).unwrap());
+    world
+        .apply_linear_impulse_to_center(c, Vec2::new(0.0, 1.0), true)
+        .unwrap();
+    assert!(world.body_is_awake(c).unwrap());
+}
+
+#[test]
+fn kinematic_bodies_move_with_their_velocity_and_carry_others() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let mut def = BodyDef::kinematic(Vec2::new(0.0, 0.0));
+    def.linear_velocity = Vec2::new(1.0, 0.0);
+    let k = world.create_body(&def).unwrap();
+    world
+        .create_shape(
+            k,
+            &ShapeDef::default(),
+            &Shape::Polygon(Polygon::new_box(5.0, 0.25).unwrap()),
+        )
+        .unwrap();
+    let rider = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 0.75))).unwrap();
+    world.create_shape(rider, &ShapeDef::default(), &unit_box()).unwrap();
+    for _ in 0..120 {
+        world.step(DT).unwrap();
+    }
+    assert!((world.body_position(k).unwrap().x - 2.0).abs() < 1e-3);
+    assert_eq!(world.body_type(k).unwrap(), BodyType::Kinematic);
+    // Static friction carries the rider with the platform.
+    assert!((world.body_linear_velocity(rider).unwrap().x - 1.0).abs() < 0.01);
+}
+
+#[test]
+fn fast_body_does_not_tunnel_through_thin_ground() {
+    // A segment ground and a small box falling at 30 m/s: 0.5 m per step, 2.5× its size.
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let g = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    world
+        .create_shape(
+            g,
+            &ShapeDef::default(),
+            &Shape::Segment(Segment::new(Vec2::new(-20.0, 0.0), Vec2::new(20.0, 0.0)).unwrap()),
+        )
+        .unwrap();
+    let mut def = BodyDef::dynamic(Vec2::new(0.0, 5.0));
+    def.linear_velocity = Vec2::new(0.0, -30.0);
+    let b = world.create_body(&def).unwrap();
+    world
+        .create_shape(
+            b,
+            &ShapeDef::default(),
+            &Shape::Polygon(Polygon::new_box(0.1, 0.1).unwrap()),
+        )
+        .unwrap();
+    let ball = world
+        .create_body(&BodyDef {
+            linear_velocity: Vec2::new(3.0, -25.0),
+            ..BodyDef::dynamic(Vec2::new(2.0, 4.0))
+        })
+        .unwrap();
+    world
+        .create_shape(
+            ball,
+            &ShapeDef::default(),
+            &Shape::Circle(Circle::new(Vec2::ZERO, 0.05).unwrap()),
+        )
+        .unwrap();
+    for _ in 0..120 {
+        world.step(DT).unwrap();
+    }
+    assert!(
+        world.body_position(b).unwrap().y > 0.0,
+        "box tunnelled: {:?}",
+        world.body_position(b)
+    );
+    assert!(world.body_position(ball).unwrap().y > 0.0, "ball tunnelled");
+}
+
+#[test]
+fn runs_are_bit_identical() {
+    fn run() -> Vec<[u32; 6]> {
+        let mut world = World::new(WorldDef::default()).unwrap();
+        ground(&mut world);
+        for i in 0..60 {
+            let x = (i % 10) as f32 * 1.1 - 5.0;
+            let y = 1.0 + (i / 10) as f32 * 1.2;
+            let mut def = BodyDef::dynamic(Vec2::new(x, y));
+            def.angle = 0.1 * i as f32;
+            def.angular_velocity = 0.5 - 0.01 * i as f32;
+            let b = world.create_body(&def).unwrap();
+            let m = Material::default().friction(0.7, 0.4).restitution(0.1 * (i % 5) as f32);
+            let shape = if i % 2 == 0 {
+                unit_box()
+            } else {
+                Shape::Circle(Circle::new(Vec2::ZERO, 0.45).unwrap())
+            };
+            world.create_shape(b, &ShapeDef::with_material(m), &shape).unwrap();
+        }
+        for _ in 0..300 {
+            world.step(DT).unwrap();
+        }
+        snapshot(&world)
+    }
+    assert_eq!(run(), run());
+}
