@@ -41,6 +41,9 @@ pub(crate) struct PointState {
     pub drift: f32,
     /// Relative tangential speed at the end of the step [m/s] (surface speed removed).
     pub slip_speed: f32,
+    /// Normal impulse per substep [N·s] the soft contact relaxes towards (a slowly
+    /// tracking average of the manifold's load, so a steady load needs no deflection).
+    pub preload: f32,
     /// Relative normal velocity at impact [m/s] (negative = approaching).
     pub approach_velocity: f32,
 }

@@ -39,7 +39,7 @@ pub const DEFAULT_SEARCH_BUDGET: u32 = 64;
 /// x
 pub const MAX_IMBALANCE: u32 = 1;
 /// x
-pub const HEIGHT_GUARD: u32 = 0;
+pub const HEIGHT_GUARD: u32 = 1;
 
 /// Number of bins of the binned-SAH split used by [`DynamicTree::rebuild`].
 const REBUILD_BINS: usize = 16;

@@ -46,11 +46,13 @@ use crate::math::Vec2;
 pub(crate) struct ConstraintPoint {
     pub r_a: Vec2,
     pub r_b: Vec2,
-    /// Separation at the step start minus the anchors' normal offset [m].
+    /// Separation at the step start [m].
     pub base_separation: f32,
-    /// Drift at the step start minus the anchors' tangential offset [m].
+    /// Stick drift at the step start [m].
     pub base_drift: f32,
     pub normal_impulse: f32,
+    /// Normal impulse the step started with: the soft row relaxes towards it, not 0.
+    pub preload: f32,
     pub tangent_impulse: f32,
     pub total_normal_impulse: f32,
     pub total_tangent_impulse: f32,
@@ -59,6 +61,8 @@ pub(crate) struct ConstraintPoint {
     pub tangent_mass: f32,
     /// Most negative normal velocity seen at the moment the point took load [m/s].
     pub approach: f32,
+    /// Normal velocity at the start of the current substep, before warm starting [m/s].
+    pub substep_vn: f32,
     pub soft: Softness,
     pub stick: bool,
     /// The point is new this step (its friction state is decided in prepare).
@@ -86,6 +90,8 @@ pub(crate) struct ContactConstraint {
     pub rolling_mass: f32,
     pub rolling_impulse: f32,
     pub tangent_speed: f32,
+    /// Frequency multiplier for unequal masses: √(m_heavy / m_light), capped.
+    pub stiffening: f32,
     pub count: usize,
     pub points: [ConstraintPoint; 2],
 }
@@ -129,6 +135,7 @@ impl ContactSolver {
             rolling_mass: 0.0,
             rolling_impulse: c.rolling_impulse,
             tangent_speed: c.material.tangent_speed,
+            stiffening: mass_ratio_stiffening(bodies.inv_mass_a, bodies.inv_mass_b),
             count: c.manifold.count,
             points: [ConstraintPoint::default(); 2],
         };
@@ -145,19 +152,20 @@ impl ContactSolver {
             let cp = &mut cc.points[i];
             cp.r_a = r_a;
             cp.r_b = r_b;
-            cp.base_separation = mp.separation - (r_b - r_a).dot(n);
+            cp.base_separation = mp.separation;
             let drift = if ps.state == FrictionState::Stick && !ps.fresh {
                 ps.drift
             } else {
                 0.0
             };
-            cp.base_drift = drift - (r_b - r_a).dot(t);
+            cp.base_drift = drift;
             cp.normal_mass = inv_or_zero(effective_mass_inv(&masses, r_a, r_b, n));
             cp.tangent_mass = inv_or_zero(effective_mass_inv(&masses, r_a, r_b, t));
             cp.normal_impulse = ps.normal_impulse;
             cp.tangent_impulse = ps.tangent_impulse;
             cp.stick = ps.state == FrictionState::Stick;
             cp.fresh = ps.fresh;
+            cp.preload = ps.preload;
             cp.approach = 0.0;
         }
         self.constraints.push(cc);
@@ -173,32 +181,63 @@ impl ContactSolver {
             let omega0 = if has_static { 2.0 * base_omega } else { base_omega };
             let n = cc.normal;
             let t = n.right_perp();
+            // Preload: the mean of the manifold's normal impulses (common mode only, so
+            // the rocking mode stays a plain damped spring).
+            let mean = cc.points[..cc.count].iter().map(|p| p.normal_impulse).sum::<f32>() / cc.count.max(1) as f32;
             for cp in cc.points[..cc.count].iter_mut() {
+                if !(ctx.preload && ctx.warm_starting) {
+                    cp.preload = 0.0;
+                }
                 if !ctx.warm_starting {
+                    cc.rolling_impulse = 0.0;
                     cp.normal_impulse = 0.0;
                     cp.tangent_impulse = 0.0;
                 }
-                // Load-adaptive frequency (module docs).
-                let load = cp.normal_impulse.max(0.0);
-                let needed = if cp.normal_mass > 0.0 && ctx.max_deflection > 0.0 {
-                    (load / (ctx.h * cp.normal_mass * ctx.max_deflection)).sqrt()
-                } else {
-                    0.0
-                };
                 cp.soft = if omega0 > 0.0 {
-                    Softness::from_omega(omega0.max(needed), ctx.contact_damping_ratio, ctx.h)
+                    Softness::from_omega(omega0 * cc.stiffening, ctx.contact_damping_ratio, ctx.h)
                 } else {
                     Softness::RIGID
                 };
                 if cp.fresh {
                     let dv = relative_velocity(&sa, &sb, cp.r_a, cp.r_b);
                     let slip = (dv.dot(t) - cc.tangent_speed).abs();
-                    let in_contact = cp.base_separation + (cp.r_b - cp.r_a).dot(n) <= crate::geometry::LINEAR_SLOP;
+                    let in_contact = cp.base_separation <= crate::geometry::LINEAR_SLOP;
                     cp.stick = !(in_contact && slip > ctx.stick_speed);
                 }
             }
         }
     }
+}
+
+fn preload_rate() -> f32 {
+    std::env::var("PRATE").ok().and_then(|s| s.parse().ok()).unwrap_or(0.1)
+}
+
+fn alpha_up() -> f32 {
+    std::env::var("PUP").ok().and_then(|s| s.parse().ok()).unwrap_or(0.05)
+}
+
+fn no_drift() -> bool {
+    std::env::var("NODRIFT").is_ok()
+}
+
+fn bias_cap() -> f32 {
+    std::env::var("BIASCAP").ok().and_then(|s| s.parse().ok()).unwrap_or(0.25)
+}
+
+/// √(m_heavy / m_light) for two dynamic bodies (1 when one side is static or kinematic),
+/// capped at `STIFFENING_CAP`. The soft contact's stiffness is `m_n ω²` with `m_n` close to
+/// the light body's mass; scaling ω by this factor makes it close to the heavy body's.
+fn mass_ratio_stiffening(inv_mass_a: f32, inv_mass_b: f32) -> f32 {
+    if inv_mass_a <= 0.0 || inv_mass_b <= 0.0 {
+        return 1.0;
+    }
+    let ratio = inv_mass_a.max(inv_mass_b) / inv_mass_a.min(inv_mass_b);
+    ratio.sqrt().min(stiff_cap())
+}
+
+fn stiff_cap() -> f32 {
+    std::env::var("STIFFCAP").ok().and_then(|s| s.parse().ok()).unwrap_or(10.0)
 }
 
 /// Inverse masses of a constraint's bodies.
@@ -250,11 +289,15 @@ fn apply(cc: &ContactConstraint, a: &mut BodyState, b: &mut BodyState, r_a: Vec2
     b.w += cc.inv_i_b * r_b.cross(p);
 }
 
-/// Relative displacement of the anchors since the step start (Box2D v3 reconstructs the
-/// separation the same way: anchors rotated by the accumulated rotation).
+/// Relative displacement of the contact point's two material points since the step start,
+/// to first order in the rotation: `Δp_b − Δp_a + sin(Δθ_b) ẑ×r_b − sin(Δθ_a) ẑ×r_a`.
+/// Box2D v3 rotates the anchors fully; the second-order term `(cos Δθ − 1) r` then lifts a
+/// spinning disk off the ground (its material point rises although its surface does not),
+/// which weakens the contact of a rolling or skidding disk (the "slipping-to-rolling comes
+/// late" error of Box2D and Rapier). The first-order form matches the velocity Jacobian.
 #[inline]
 fn anchor_displacement(a: &BodyState, b: &BodyState, r_a: Vec2, r_b: Vec2) -> Vec2 {
-    (b.dp - a.dp) + (b.dq.rotate(r_b) - a.dq.rotate(r_a))
+    (b.dp - a.dp) + (b.dq.s * r_b.left_perp() - a.dq.s * r_a.left_perp())
 }
 
 /// Reads two body states; index 0 is the shared static body, never written.
@@ -281,10 +324,17 @@ impl ConstraintSet for ContactSolver {
     }
 
     fn warm_start(&mut self, states: &mut [BodyState]) {
-        for cc in &self.constraints {
+        for cc in &mut self.constraints {
             let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
             let n = cc.normal;
             let t = n.right_perp();
+            if cc.restitution > 0.0 {
+                // Impact speed for restitution: the approach velocity before this
+                // substep's impulses, whichever pass then catches the impact.
+                for cp in &mut cc.points[..cc.count] {
+                    cp.substep_vn = relative_velocity(&a, &b, cp.r_a, cp.r_b).dot(n);
+                }
+            }
             for cp in &cc.points[..cc.count] {
                 let p = cp.normal_impulse * n + cp.tangent_impulse * t;
                 apply(cc, &mut a, &mut b, cp.r_a, cp.r_b, p);
@@ -319,15 +369,16 @@ impl ConstraintSet for ContactSolver {
                     (0.0, 1.0, 0.0)
                 };
                 let vn = relative_velocity(&a, &b, cp.r_a, cp.r_b).dot(n);
-                let impulse = -cp.normal_mass * mass_scale * (vn + bias) - impulse_scale * cp.normal_impulse;
+                let impulse =
+                    -cp.normal_mass * mass_scale * (vn + bias) - impulse_scale * (cp.normal_impulse - cp.preload);
                 let new = (cp.normal_impulse + impulse).max(0.0);
                 let delta = new - cp.normal_impulse;
                 apply(cc, &mut a, &mut b, cp.r_a, cp.r_b, delta * n);
                 let cp = &mut cc.points[i];
                 cp.normal_impulse = new;
                 cp.max_normal_impulse = cp.max_normal_impulse.max(new);
-                if use_bias && new > 0.0 && vn < cp.approach {
-                    cp.approach = vn;
+                if new > 0.0 && cp.substep_vn < cp.approach {
+                    cp.approach = cp.substep_vn;
                 }
                 total_normal += new;
             }
@@ -337,7 +388,7 @@ impl ConstraintSet for ContactSolver {
                 let mu = if cp.stick { cc.mu_s } else { cc.mu_d };
                 let limit = mu * cp.normal_impulse;
                 let vt = relative_velocity(&a, &b, cp.r_a, cp.r_b).dot(t) - cc.tangent_speed;
-                let bias = if use_bias && cp.stick && cp.normal_impulse > 0.0 {
+                let bias = if use_bias && cp.stick && cp.normal_impulse > 0.0 && !no_drift() {
                     let d = anchor_displacement(&a, &b, cp.r_a, cp.r_b);
                     let drift = d.dot(t) + cp.base_drift - cc.tangent_speed * elapsed;
                     (cp.soft.bias_rate * drift).clamp(-ctx.push_speed, ctx.push_speed)
@@ -411,6 +462,8 @@ pub(crate) fn store_impulses(cc: &ContactConstraint, contact: &mut Contact, stat
     let (a, b) = load(states, cc.index_a, cc.index_b);
     let t = cc.normal.right_perp();
     contact.rolling_impulse = cc.rolling_impulse;
+    let mean = cc.points[..cc.count].iter().map(|p| p.normal_impulse).sum::<f32>() / cc.count.max(1) as f32;
+    let alpha = preload_rate();
     for (cp, ps) in cc.points[..cc.count].iter().zip(contact.points.iter_mut()) {
         ps.normal_impulse = cp.normal_impulse;
         ps.tangent_impulse = cp.tangent_impulse;
@@ -418,6 +471,8 @@ pub(crate) fn store_impulses(cc: &ContactConstraint, contact: &mut Contact, stat
         ps.total_tangent_impulse = cp.total_tangent_impulse;
         ps.max_normal_impulse = cp.max_normal_impulse;
         ps.approach_velocity = cp.approach;
+        let rate = if mean > cp.preload { alpha_up() } else { alpha };
+        ps.preload = if cp.max_normal_impulse > 0.0 { cp.preload + rate * (mean - cp.preload) } else { 0.0 };
         ps.fresh = false;
         let vt = relative_velocity(&a, &b, cp.r_a, cp.r_b).dot(t) - cc.tangent_speed;
         ps.slip_speed = vt.abs();

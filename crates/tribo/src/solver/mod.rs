@@ -75,6 +75,8 @@ pub(crate) struct StepContext {
     /// Largest linear speed [m/s].
     pub max_linear_speed: f32,
     pub warm_starting: bool,
+    /// Soft rows relax towards the impulse the step started with (experimental switch).
+    pub preload: bool,
 }
 
 /// A family of constraints solved by the step (contacts now; joints later).
@@ -101,9 +103,9 @@ pub(crate) fn solve_step<C: ConstraintSet>(
     constraints.prepare(ctx, states);
     for i in 0..ctx.substeps {
         integrate_velocities(ctx, sims, states);
-        if ctx.warm_starting {
-            constraints.warm_start(states);
-        }
+        // Always called: it also records approach speeds (impulses are zero when warm
+        // starting is off).
+        constraints.warm_start(states);
         let elapsed = i as f32 * ctx.h;
         constraints.solve(ctx, states, true, elapsed);
         integrate_positions(ctx, states);

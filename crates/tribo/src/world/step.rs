@@ -61,6 +61,7 @@ impl World {
             stick_speed: self.def.stick_speed,
             max_linear_speed: self.def.max_linear_speed,
             warm_starting: self.def.warm_starting,
+            preload: std::env::var("PRELOAD").is_ok(),
         }
     }
 
