@@ -37,9 +37,9 @@ const STACK_FIXED: usize = 128;
 pub const DEFAULT_SEARCH_BUDGET: u32 = 64;
 
 /// x
-pub const MAX_IMBALANCE: u32 = 1;
+pub const MAX_IMBALANCE: u32 = 2;
 /// x
-pub const HEIGHT_GUARD: u32 = 1;
+pub const HEIGHT_GUARD: u32 = 0;
 
 /// Number of bins of the binned-SAH split used by [`DynamicTree::rebuild`].
 const REBUILD_BINS: usize = 16;

@@ -40,8 +40,6 @@ pub(crate) struct BodyState {
 /// Per-body constants of a step (cold relative to [`BodyState`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct BodySim {
-    pub inv_mass: f32,
-    pub inv_inertia: f32,
     /// Acceleration from gravity and applied forces [m/s²].
     pub linear_accel: Vec2,
     /// Angular acceleration from applied torques [rad/s²].
@@ -59,24 +57,16 @@ pub(crate) struct StepContext {
     pub h: f32,
     pub inv_h: f32,
     pub substeps: u32,
-    /// Softness of contacts between two moving bodies.
-    pub contact_softness: Softness,
-    /// Softness of contacts with a static body (twice the frequency, as in Box2D v3).
-    pub static_softness: Softness,
     /// Contact frequency [Hz] used for the base softness (after clamping).
     pub contact_hertz: f32,
     pub contact_damping_ratio: f32,
     /// Largest speed at which overlap is pushed apart [m/s].
     pub push_speed: f32,
-    /// Largest static deflection a contact may show under its current load [m].
-    pub max_deflection: f32,
     /// Slip speed below which a sliding point sticks again [m/s].
     pub stick_speed: f32,
     /// Largest linear speed [m/s].
     pub max_linear_speed: f32,
     pub warm_starting: bool,
-    /// Soft rows relax towards the impulse the step started with (experimental switch).
-    pub preload: bool,
 }
 
 /// A family of constraints solved by the step (contacts now; joints later).

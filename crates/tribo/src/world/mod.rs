@@ -41,10 +41,6 @@ pub struct WorldDef {
     pub contact_damping_ratio: f32,
     /// Largest speed at which overlapping shapes are pushed apart [m/s]. Default 3.
     pub contact_push_speed: f32,
-    /// Largest static deflection [m] a contact may show under its load: heavily loaded
-    /// contacts are stiffened until they sink no more than this (what keeps a heavy box
-    /// from sinking into a light one). Default 0.0002 m (0.2 mm); 0 disables.
-    pub max_contact_deflection: f32,
     /// Slip speed [m/s] below which a sliding contact point sticks again. Default 0.01.
     pub stick_speed: f32,
     /// Largest linear speed of any body [m/s]. Default 400.
@@ -65,7 +61,6 @@ impl Default for WorldDef {
             contact_hertz: 30.0,
             contact_damping_ratio: 10.0,
             contact_push_speed: 3.0,
-            max_contact_deflection: 0.0002,
             stick_speed: 0.01,
             max_linear_speed: 400.0,
             enable_sleep: true,
@@ -88,7 +83,6 @@ impl WorldDef {
         check_non_negative("WorldDef::contact_hertz", self.contact_hertz)?;
         check_non_negative("WorldDef::contact_damping_ratio", self.contact_damping_ratio)?;
         check_positive("WorldDef::contact_push_speed", self.contact_push_speed)?;
-        check_non_negative("WorldDef::max_contact_deflection", self.max_contact_deflection)?;
         check_non_negative("WorldDef::stick_speed", self.stick_speed)?;
         check_positive("WorldDef::max_linear_speed", self.max_linear_speed)?;
         check_non_negative("WorldDef::time_to_sleep", self.time_to_sleep)?;

@@ -14,7 +14,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
 use crate::solver::contact_solver::{store_impulses, ConstraintBodies};
-use crate::solver::{solve_step, BodySim, BodyState, Softness, StepContext};
+use crate::solver::{solve_step, BodySim, BodyState, StepContext};
 use crate::world::BodyId;
 
 impl World {
@@ -52,16 +52,12 @@ impl World {
             h,
             inv_h: 1.0 / h,
             substeps,
-            contact_softness: Softness::new(hertz, zeta, h),
-            static_softness: Softness::new(2.0 * hertz, zeta, h),
             contact_hertz: hertz,
             contact_damping_ratio: zeta,
             push_speed: self.def.contact_push_speed,
-            max_deflection: self.def.max_contact_deflection,
             stick_speed: self.def.stick_speed,
             max_linear_speed: self.def.max_linear_speed,
             warm_starting: self.def.warm_starting,
-            preload: std::env::var("PRELOAD").is_ok(),
         }
     }
 
@@ -261,8 +257,6 @@ impl World {
             let force = b.force + b.constant_force;
             let torque = b.torque + b.constant_torque;
             self.sims.push(BodySim {
-                inv_mass: b.inv_mass,
-                inv_inertia: b.inv_inertia,
                 linear_accel: if dynamic {
                     b.inv_mass * force + b.gravity_scale * g
                 } else {
