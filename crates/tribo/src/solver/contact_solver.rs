@@ -319,6 +319,12 @@ fn solve_block(cc: &ContactConstraint, rows: &[NormalRow; 2]) -> Option<[f32; 2]
 /// about a second while staying stable.
 const PRELOAD_RATE: f32 = 0.05;
 
+/// Rigid iterations used to estimate the impulses of contacts that begin at rest.
+const ESTIMATE_ITERATIONS: usize = 8;
+
+/// Approach speed [m/s] below which a new touching contact counts as resting.
+const RESTING_SPEED: f32 = 0.5;
+
 /// Inverse masses of a constraint's bodies.
 struct Masses {
     ma: f32,
@@ -426,14 +432,52 @@ impl ConstraintSet for ContactSolver {
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, elapsed: f32) {
         for cc in &mut self.constraints {
-            let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
-            solve_normals(cc, &mut a, &mut b, ctx, use_bias);
-            solve_friction(cc, &mut a, &mut b, ctx, use_bias, elapsed);
-            if cc.rolling_resistance > 0.0 && !use_bias {
-                solve_rolling(cc, &mut a, &mut b);
-            }
-            store(states, cc.index_a, cc.index_b, a, b);
+            solve_one(cc, states, ctx, use_bias, elapsed);
         }
+    }
+
+    fn has_new_contacts(&self) -> bool {
+        self.constraints.iter().any(|cc| cc.points[..cc.count].iter().any(|p| p.fresh))
+    }
+
+    fn record_approach(&mut self, states: &[BodyState]) {
+        for cc in &mut self.constraints {
+            let (a, b) = load(states, cc.index_a, cc.index_b);
+            for cp in &mut cc.points[..cc.count] {
+                cp.substep_vn = relative_velocity(&a, &b, cp.r_a, cp.r_b).dot(cc.normal);
+            }
+        }
+    }
+
+    fn estimate_new_contacts(&mut self, ctx: &StepContext, trial: &mut [BodyState]) -> bool {
+        // Contacts that are new and resting: every point fresh, touching and not hitting.
+        let mut subset = Vec::new();
+        for (i, cc) in self.constraints.iter().enumerate() {
+            let resting = cc.points[..cc.count].iter().all(|p| {
+                p.fresh && p.base_separation <= crate::geometry::LINEAR_SLOP && p.substep_vn > -RESTING_SPEED
+            });
+            if cc.count > 0 && resting {
+                subset.push(i);
+            }
+        }
+        if subset.is_empty() {
+            return false;
+        }
+        for _ in 0..ESTIMATE_ITERATIONS {
+            for &i in &subset {
+                solve_one(&mut self.constraints[i], trial, ctx, false, 0.0);
+            }
+        }
+        for &i in &subset {
+            let cc = &mut self.constraints[i];
+            for cp in &mut cc.points[..cc.count] {
+                cp.preload = cp.normal_impulse;
+                cp.max_normal_impulse = 0.0;
+                cp.approach = 0.0;
+                cp.saturated = false;
+            }
+        }
+        true
     }
 
     fn end_substep(&mut self) {
@@ -470,6 +514,17 @@ impl ConstraintSet for ContactSolver {
             store(states, cc.index_a, cc.index_b, a, b);
         }
     }
+}
+
+/// One pass over one contact: normal rows, friction rows, rolling resistance.
+fn solve_one(cc: &mut ContactConstraint, states: &mut [BodyState], ctx: &StepContext, use_bias: bool, elapsed: f32) {
+    let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
+    solve_normals(cc, &mut a, &mut b, ctx, use_bias);
+    solve_friction(cc, &mut a, &mut b, ctx, use_bias, elapsed);
+    if cc.rolling_resistance > 0.0 && !use_bias {
+        solve_rolling(cc, &mut a, &mut b);
+    }
+    store(states, cc.index_a, cc.index_b, a, b);
 }
 
 /// Normal rows: the two points of a manifold together when the 2×2 system is well

@@ -73,12 +73,20 @@ pub(crate) struct StepContext {
 pub(crate) trait ConstraintSet {
     /// Computes anchors, masses and softness; loads warm-start impulses.
     fn prepare(&mut self, ctx: &StepContext, states: &[BodyState]);
+    /// Whether any constraint has points new this step.
+    fn has_new_contacts(&self) -> bool;
+    /// Records each point's normal velocity in `states` (before any impulse).
+    fn record_approach(&mut self, states: &[BodyState]);
     /// Re-applies the accumulated impulses at the start of a substep.
     fn warm_start(&mut self, states: &mut [BodyState]);
     /// One sequential-impulse pass; `use_bias` adds the soft position correction.
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, elapsed: f32);
     /// Accumulates what a substep applied (after its relax pass).
     fn end_substep(&mut self);
+    /// Estimates warm-start impulses for constraints that begin at rest (no history):
+    /// rigid iterations against `trial`, the states after one substep of forces. Returns
+    /// whether any constraint was estimated. The trial velocities are thrown away.
+    fn estimate_new_contacts(&mut self, ctx: &StepContext, trial: &mut [BodyState]) -> bool;
     /// Restitution pass after all substeps.
     fn restitution(&mut self, states: &mut [BodyState]);
 }
@@ -91,6 +99,15 @@ pub(crate) fn solve_step<C: ConstraintSet>(
     constraints: &mut C,
 ) {
     constraints.prepare(ctx, states);
+    // A contact that begins at rest has no warm start: its first substeps would let the
+    // body sag and slide before the load builds up (the settling creep of Box2D and
+    // Rapier). Estimate its impulses first on a scratch copy of the states.
+    if constraints.has_new_contacts() {
+        let mut trial = states.to_vec();
+        integrate_velocities(ctx, sims, &mut trial);
+        constraints.record_approach(&trial);
+        constraints.estimate_new_contacts(ctx, &mut trial);
+    }
     for i in 0..ctx.substeps {
         integrate_velocities(ctx, sims, states);
         // Always called: it also records approach speeds (impulses are zero when warm
