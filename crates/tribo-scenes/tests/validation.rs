@@ -85,3 +85,15 @@ fn mass_ratio() {
 fn conservation() {
     assert_checks(validation::conservation());
 }
+
+#[test]
+#[ignore = "known failure: 100:1 heavy-on-light on a slope slides off (friction converges too slowly through the light box); see KNOWN_FAILURES"]
+fn mass_ratio_slope() {
+    assert_checks(validation::mass_ratio_slope());
+}
+
+#[test]
+#[ignore = "known failure: angular momentum drifts ~1e-3 and e = 1 gains ~1e-3 KE per step; see KNOWN_FAILURES"]
+fn conservation_exact() {
+    assert_checks(validation::conservation_exact());
+}

@@ -105,6 +105,8 @@ pub(crate) struct ContactConstraint {
     pub inv_k: [f32; 3],
     /// The 2×2 block solver applies (two points, well conditioned).
     pub block: bool,
+    /// Effective mass of the patch friction row at the middle of two points [kg].
+    pub patch_tangent_mass: f32,
     pub count: usize,
     pub points: [ConstraintPoint; 2],
 }
@@ -151,6 +153,7 @@ impl ContactSolver {
             k: [0.0; 3],
             inv_k: [0.0; 3],
             block: false,
+            patch_tangent_mass: 0.0,
             count: c.manifold.count,
             points: [ConstraintPoint::default(); 2],
         };
@@ -185,6 +188,8 @@ impl ContactSolver {
         }
         if cc.count == 2 {
             let (p0, p1) = (&cc.points[0], &cc.points[1]);
+            let (rc_a, rc_b) = (0.5 * (p0.r_a + p1.r_a), 0.5 * (p0.r_b + p1.r_b));
+            cc.patch_tangent_mass = inv_or_zero(effective_mass_inv(&masses, rc_a, rc_b, t));
             let (ra0, rb0, ra1, rb1) = (p0.r_a.cross(n), p0.r_b.cross(n), p1.r_a.cross(n), p1.r_b.cross(n));
             let m = masses.ma + masses.mb;
             let k11 = m + masses.ia * ra0 * ra0 + masses.ib * rb0 * rb0;
@@ -209,7 +214,11 @@ impl ContactSolver {
             let (sa, sb) = (states[cc.index_a as usize], states[cc.index_b as usize]);
             let has_static = cc.index_a == 0 || cc.index_b == 0;
             // Contacts with static bodies are twice as stiff (Box2D v3's static softness).
-            let hertz = if has_static { 2.0 * ctx.contact_hertz } else { ctx.contact_hertz };
+            let hertz = if has_static {
+                2.0 * ctx.contact_hertz
+            } else {
+                ctx.contact_hertz
+            };
             let n = cc.normal;
             let t = n.right_perp();
             for cp in cc.points[..cc.count].iter_mut() {
@@ -243,7 +252,14 @@ struct NormalRow {
 }
 
 #[inline]
-fn normal_row(cp: &ConstraintPoint, a: &BodyState, b: &BodyState, n: Vec2, ctx: &StepContext, use_bias: bool) -> NormalRow {
+fn normal_row(
+    cp: &ConstraintPoint,
+    a: &BodyState,
+    b: &BodyState,
+    n: Vec2,
+    ctx: &StepContext,
+    use_bias: bool,
+) -> NormalRow {
     let d = anchor_displacement(a, b, cp.r_a, cp.r_b);
     let s = d.dot(n) + cp.base_separation;
     let (bias, mass_scale, impulse_scale) = if s > 0.0 {
@@ -320,7 +336,7 @@ fn solve_block(cc: &ContactConstraint, rows: &[NormalRow; 2]) -> Option<[f32; 2]
 const PRELOAD_RATE: f32 = 0.05;
 
 /// Rigid iterations used to estimate the impulses of contacts that begin at rest.
-const ESTIMATE_ITERATIONS: usize = 8;
+const ESTIMATE_ITERATIONS: usize = 128;
 
 /// Approach speed [m/s] below which a new touching contact counts as resting.
 const RESTING_SPEED: f32 = 0.5;
@@ -437,7 +453,9 @@ impl ConstraintSet for ContactSolver {
     }
 
     fn has_new_contacts(&self) -> bool {
-        self.constraints.iter().any(|cc| cc.points[..cc.count].iter().any(|p| p.fresh))
+        self.constraints
+            .iter()
+            .any(|cc| cc.points[..cc.count].iter().any(|p| p.fresh))
     }
 
     fn record_approach(&mut self, states: &[BodyState]) {
@@ -453,9 +471,9 @@ impl ConstraintSet for ContactSolver {
         // Contacts that are new and resting: every point fresh, touching and not hitting.
         let mut subset = Vec::new();
         for (i, cc) in self.constraints.iter().enumerate() {
-            let resting = cc.points[..cc.count].iter().all(|p| {
-                p.fresh && p.base_separation <= crate::geometry::LINEAR_SLOP && p.substep_vn > -RESTING_SPEED
-            });
+            let resting = cc.points[..cc.count]
+                .iter()
+                .all(|p| p.fresh && p.base_separation <= crate::geometry::LINEAR_SLOP && p.substep_vn > -RESTING_SPEED);
             if cc.count > 0 && resting {
                 subset.push(i);
             }
@@ -520,6 +538,10 @@ impl ConstraintSet for ContactSolver {
 fn solve_one(cc: &mut ContactConstraint, states: &mut [BodyState], ctx: &StepContext, use_bias: bool, elapsed: f32) {
     let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
     solve_normals(cc, &mut a, &mut b, ctx, use_bias);
+    if cc.points[..cc.count].iter().any(|p| p.normal_impulse > 0.0) {
+        a.touched = 1.0;
+        b.touched = 1.0;
+    }
     solve_friction(cc, &mut a, &mut b, ctx, use_bias, elapsed);
     if cc.rolling_resistance > 0.0 && !use_bias {
         solve_rolling(cc, &mut a, &mut b);
@@ -535,7 +557,11 @@ fn solve_normals(cc: &mut ContactConstraint, a: &mut BodyState, b: &mut BodyStat
     for (row, cp) in rows.iter_mut().zip(&cc.points[..cc.count]) {
         *row = normal_row(cp, a, b, n, ctx, use_bias);
     }
-    let block = if cc.count == 2 && cc.block { solve_block(cc, &rows) } else { None };
+    let block = if cc.count == 2 && cc.block {
+        solve_block(cc, &rows)
+    } else {
+        None
+    };
     match block {
         Some(x) => {
             for (i, &xi) in x.iter().enumerate() {
@@ -547,7 +573,11 @@ fn solve_normals(cc: &mut ContactConstraint, a: &mut BodyState, b: &mut BodyStat
         None => {
             for i in 0..cc.count {
                 let cp = cc.points[i];
-                let row = if i == 0 { rows[0] } else { normal_row(&cp, a, b, n, ctx, use_bias) };
+                let row = if i == 0 {
+                    rows[0]
+                } else {
+                    normal_row(&cp, a, b, n, ctx, use_bias)
+                };
                 let impulse = -cp.normal_mass * row.mass_scale * (row.vn + row.bias)
                     - row.impulse_scale * (cp.normal_impulse - cp.preload);
                 let new = (cp.normal_impulse + impulse).max(0.0);
@@ -565,9 +595,16 @@ fn solve_normals(cc: &mut ContactConstraint, a: &mut BodyState, b: &mut BodyStat
     }
 }
 
-/// Friction rows, after the normal rows so the clamp uses this pass's λn. The limit is
-/// μs·λn while sticking, μd·λn while slipping; a sticking row's biased pass also drives
-/// the drift back to zero.
+/// Friction, after the normal rows so the clamp uses this pass's λn. The limit is μs·λn
+/// while sticking, μd·λn while slipping; a sticking row's biased pass also drives the
+/// drift back to zero.
+///
+/// A 2-point manifold (a face contact) gets one friction row at the middle of its points,
+/// clamped by μ times the sum of their normal impulses: the patch grips or slides as a
+/// whole (PhysX's patch friction; in 2D there is no twist row). Per-point rows solved in
+/// turn put all the friction on whichever point comes first, which then saturates at its
+/// own share while the other has room; with a light body between a heavy one and the
+/// ground that starves the contact of friction for many steps.
 fn solve_friction(
     cc: &mut ContactConstraint,
     a: &mut BodyState,
@@ -577,6 +614,34 @@ fn solve_friction(
     elapsed: f32,
 ) {
     let t = cc.normal.right_perp();
+    if cc.count == 2 {
+        let (p0, p1) = (cc.points[0], cc.points[1]);
+        let r_a = 0.5 * (p0.r_a + p1.r_a);
+        let r_b = 0.5 * (p0.r_b + p1.r_b);
+        let stick = p0.stick && p1.stick;
+        let mu = if stick { cc.mu_s } else { cc.mu_d };
+        let limit = mu * (p0.normal_impulse + p1.normal_impulse);
+        let vt = relative_velocity(a, b, r_a, r_b).dot(t) - cc.tangent_speed;
+        let bias = if use_bias && stick && limit > 0.0 {
+            let d = anchor_displacement(a, b, r_a, r_b);
+            let drift = d.dot(t) + 0.5 * (p0.base_drift + p1.base_drift) - cc.tangent_speed * elapsed;
+            (p0.soft.bias_rate * drift).clamp(-ctx.push_speed, ctx.push_speed)
+        } else {
+            0.0
+        };
+        let old = p0.tangent_impulse + p1.tangent_impulse;
+        let impulse = -cc.patch_tangent_mass * (vt + bias);
+        let unclamped = old + impulse;
+        let new = unclamped.clamp(-limit, limit);
+        apply(cc, a, b, r_a, r_b, (new - old) * t);
+        for cp in &mut cc.points {
+            cp.tangent_impulse = 0.5 * new;
+            if !use_bias {
+                cp.saturated = limit > 0.0 && unclamped.abs() > limit;
+            }
+        }
+        return;
+    }
     for i in 0..cc.count {
         let cp = cc.points[i];
         let mu = if cp.stick { cc.mu_s } else { cc.mu_d };
@@ -620,6 +685,14 @@ pub(crate) fn store_impulses(cc: &ContactConstraint, contact: &mut Contact, stat
     let t = cc.normal.right_perp();
     contact.rolling_impulse = cc.rolling_impulse;
     let mean = cc.points[..cc.count].iter().map(|p| p.normal_impulse).sum::<f32>() / cc.count.max(1) as f32;
+    // A face contact slides as a whole: its points turn to Slip only when the manifold's
+    // total friction reached μs times its total normal impulse (PhysX's per-patch
+    // "broken" flag), not when sequential solving happened to load one point to its
+    // share's limit while the other still had room.
+    let (sum_t, sum_n) = cc.points[..cc.count].iter().fold((0.0f32, 0.0f32), |(t, n), p| {
+        (t + p.tangent_impulse, n + p.normal_impulse)
+    });
+    let patch_saturated = sum_t.abs() >= 0.999 * cc.mu_s * sum_n && cc.points[..cc.count].iter().any(|p| p.saturated);
     for (cp, ps) in cc.points[..cc.count].iter().zip(contact.points.iter_mut()) {
         ps.normal_impulse = cp.normal_impulse;
         ps.tangent_impulse = cp.tangent_impulse;
@@ -629,16 +702,24 @@ pub(crate) fn store_impulses(cc: &ContactConstraint, contact: &mut Contact, stat
         ps.approach_velocity = cp.approach;
         // Preload tracking (module docs): per point against static bodies, the manifold
         // mean between two moving bodies; a new point starts at its first load.
-        let target = if cc.index_a == 0 || cc.index_b == 0 { cp.normal_impulse } else { mean };
+        let target = if cc.index_a == 0 || cc.index_b == 0 {
+            cp.normal_impulse
+        } else {
+            mean
+        };
         let rate = if cp.fresh { 1.0 } else { PRELOAD_RATE };
-        ps.preload = if cp.max_normal_impulse > 0.0 { cp.preload + rate * (target - cp.preload) } else { 0.0 };
+        ps.preload = if cp.max_normal_impulse > 0.0 {
+            cp.preload + rate * (target - cp.preload)
+        } else {
+            0.0
+        };
         ps.fresh = false;
         let vt = relative_velocity(&a, &b, cp.r_a, cp.r_b).dot(t) - cc.tangent_speed;
         ps.slip_speed = vt.abs();
         let loaded = cp.max_normal_impulse > 0.0;
         let mut stick = cp.stick;
         if loaded {
-            if stick && cp.saturated && ps.slip_speed > ctx.stick_speed {
+            if stick && patch_saturated && ps.slip_speed > ctx.stick_speed {
                 stick = false;
             } else if !stick && ps.slip_speed < ctx.stick_speed {
                 stick = true;

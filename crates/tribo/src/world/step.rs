@@ -249,7 +249,7 @@ impl World {
             self.states.push(BodyState {
                 v: b.v,
                 w: b.w,
-                _pad: 0.0,
+                touched: 0.0,
                 dp: Vec2::ZERO,
                 dq: Rot::IDENTITY,
             });
