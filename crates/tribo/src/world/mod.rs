@@ -355,14 +355,22 @@ impl World {
     pub fn apply_force(&mut self, id: BodyId, force: Vec2, world_point: Vec2, wake: bool) -> Result<()> {
         check_vec("force", force)?;
         check_vec("world_point", world_point)?;
+        self.push_awake_dynamic(id, wake, |b| {
+            b.force += force;
+            b.torque += (world_point - b.center).cross(force);
+        })
+    }
+
+    /// Shared tail of the force and impulse calls: wakes the body if asked, then changes
+    /// it if it is dynamic and awake (a sleeping body not woken ignores the push).
+    fn push_awake_dynamic(&mut self, id: BodyId, wake: bool, change: impl FnOnce(&mut Body)) -> Result<()> {
         self.body_ref(id)?;
         if wake {
             self.wake_body(id.index);
         }
         let b = self.body_mut(id)?;
         if b.is_dynamic() && b.awake {
-            b.force += force;
-            b.torque += (world_point - b.center).cross(force);
+            change(b);
         }
         Ok(())
     }
@@ -376,31 +384,19 @@ impl World {
     /// Applies a torque [N·m] during the next step.
     pub fn apply_torque(&mut self, id: BodyId, torque: f32, wake: bool) -> Result<()> {
         check_finite("torque", torque)?;
-        self.body_ref(id)?;
-        if wake {
-            self.wake_body(id.index);
-        }
-        let b = self.body_mut(id)?;
-        if b.is_dynamic() && b.awake {
+        self.push_awake_dynamic(id, wake, |b| {
             b.torque += torque;
-        }
-        Ok(())
+        })
     }
 
     /// Applies an impulse [N·s] at a world point [m]: changes the velocity at once.
     pub fn apply_linear_impulse(&mut self, id: BodyId, impulse: Vec2, world_point: Vec2, wake: bool) -> Result<()> {
         check_vec("impulse", impulse)?;
         check_vec("world_point", world_point)?;
-        self.body_ref(id)?;
-        if wake {
-            self.wake_body(id.index);
-        }
-        let b = self.body_mut(id)?;
-        if b.is_dynamic() && b.awake {
+        self.push_awake_dynamic(id, wake, |b| {
             b.v += b.inv_mass * impulse;
             b.w += b.inv_inertia * (world_point - b.center).cross(impulse);
-        }
-        Ok(())
+        })
     }
 
     /// Applies an impulse [N·s] at the centre of mass.
@@ -412,15 +408,9 @@ impl World {
     /// Applies an angular impulse [N·m·s].
     pub fn apply_angular_impulse(&mut self, id: BodyId, impulse: f32, wake: bool) -> Result<()> {
         check_finite("impulse", impulse)?;
-        self.body_ref(id)?;
-        if wake {
-            self.wake_body(id.index);
-        }
-        let b = self.body_mut(id)?;
-        if b.is_dynamic() && b.awake {
+        self.push_awake_dynamic(id, wake, |b| {
             b.w += b.inv_inertia * impulse;
-        }
-        Ok(())
+        })
     }
 
     /// Sets the constant force [N] applied at the centre of mass every step; wakes the body.
