@@ -122,12 +122,8 @@ pub const EXPERIMENTS: &[Experiment] = &[
 
 /// Experiments that fail today (known solver limits, reported, not hidden): a heavy box
 /// on a light one on a slope (friction through a 100:1 chain converges too slowly with
-/// one sequential-impulse iteration), and exact angular momentum / elastic energy with
-/// fixed anchors inside a step.
-pub const KNOWN_FAILURES: &[Experiment] = &[
-    ("mass_ratio_slope", mass_ratio_slope),
-    ("conservation_exact", conservation_exact),
-];
+/// one sequential-impulse iteration).
+pub const KNOWN_FAILURES: &[Experiment] = &[("mass_ratio_slope", mass_ratio_slope)];
 
 /// Material of the friction experiments: μs = 0.6, μd = 0.4.
 pub fn wood() -> Material {
@@ -710,25 +706,6 @@ fn mass_ratio_cases(cases: &[(&str, f32)]) -> Result<Vec<Check>> {
 /// Zero gravity, e = 1, μ = 0: collisions conserve linear and angular momentum and never
 /// raise kinetic energy; with e = 0.5, energy never rises either.
 pub fn conservation() -> Result<Vec<Check>> {
-    Ok(conservation_all()?
-        .into_iter()
-        .filter(|c| {
-            c.formula.contains("linear momentum") || (c.formula.contains("kinetic") && !c.formula.contains("e = 1,"))
-        })
-        .collect())
-}
-
-/// The conservation checks that fail today: angular momentum to 1e-6 (impulses act at
-/// anchors fixed at the start of the step, so a pair that slides along its contact within
-/// a step gets a tiny torque couple) and no kinetic-energy rise at e = 1.
-pub fn conservation_exact() -> Result<Vec<Check>> {
-    Ok(conservation_all()?
-        .into_iter()
-        .filter(|c| c.formula.contains("angular") || (c.formula.contains("kinetic") && c.formula.contains("e = 1,")))
-        .collect())
-}
-
-fn conservation_all() -> Result<Vec<Check>> {
     let mut out = Vec::new();
     for e in [1.0f32, 0.5] {
         let m = Material {

@@ -105,6 +105,11 @@ pub(crate) struct ContactConstraint {
     pub inv_k: [f32; 3],
     /// The 2×2 block solver applies (two points, well conditioned).
     pub block: bool,
+    /// Where impulses act between the two bodies' anchors as they move apart within a step:
+    /// `m_a⁻¹ / (m_a⁻¹ + m_b⁻¹)` (see [`lever_arms`]).
+    pub split: f32,
+    /// Kinetic energy of the two bodies at the start of the step [J] (restitution cap).
+    pub kinetic_energy: f32,
     /// Effective mass of the patch friction row at the middle of two points [kg].
     pub patch_tangent_mass: f32,
     pub count: usize,
@@ -154,6 +159,15 @@ impl ContactSolver {
             inv_k: [0.0; 3],
             block: false,
             patch_tangent_mass: 0.0,
+            kinetic_energy: 0.0,
+            split: {
+                let sum = bodies.inv_mass_a + bodies.inv_mass_b;
+                if sum > 0.0 {
+                    bodies.inv_mass_b / sum
+                } else {
+                    0.5
+                }
+            },
             count: c.manifold.count,
             points: [ConstraintPoint::default(); 2],
         };
@@ -213,6 +227,9 @@ impl ContactSolver {
         for cc in self.constraints.iter_mut() {
             let (sa, sb) = (states[cc.index_a as usize], states[cc.index_b as usize]);
             let has_static = cc.index_a == 0 || cc.index_b == 0;
+            if cc.restitution > 0.0 {
+                cc.kinetic_energy = pair_kinetic_energy(cc, &sa, &sb);
+            }
             // Contacts with static bodies are twice as stiff (Box2D v3's static softness).
             let hertz = if has_static {
                 2.0 * ctx.contact_hertz
@@ -253,13 +270,14 @@ struct NormalRow {
 
 #[inline]
 fn normal_row(
+    cc: &ContactConstraint,
     cp: &ConstraintPoint,
     a: &BodyState,
     b: &BodyState,
-    n: Vec2,
     ctx: &StepContext,
     use_bias: bool,
 ) -> NormalRow {
+    let n = cc.normal;
     let d = anchor_displacement(a, b, cp.r_a, cp.r_b);
     let s = d.dot(n) + cp.base_separation;
     let (bias, mass_scale, impulse_scale) = if s > 0.0 {
@@ -275,7 +293,7 @@ fn normal_row(
         (0.0, 1.0, 0.0)
     };
     NormalRow {
-        vn: relative_velocity(a, b, cp.r_a, cp.r_b).dot(n),
+        vn: point_velocity(cc, a, b, cp.r_a, cp.r_b).dot(n),
         bias,
         mass_scale,
         impulse_scale,
@@ -375,15 +393,51 @@ fn inv_or_zero(k: f32) -> f32 {
     }
 }
 
+/// Lever arms of an impulse at substep time: the anchors are fixed at the start of the
+/// step, but the two bodies move apart within it, so A's anchor and B's anchor drift to
+/// different world points. Applying ±P at two different points would add a torque couple
+/// (dp_b − dp_a) × P and break conservation of angular momentum. Both arms are therefore
+/// moved to one common point, weighted toward the lighter body's anchor (the static side's
+/// anchor does not matter):
+/// `p = p_a + w (p_b − p_a)` with `w = m_b⁻¹ / (m_a⁻¹ + m_b⁻¹)`.
+#[inline]
+fn lever_arms(cc: &ContactConstraint, a: &BodyState, b: &BodyState, r_a: Vec2, r_b: Vec2) -> (Vec2, Vec2) {
+    let d = b.dp - a.dp;
+    (r_a + cc.split * d, r_b - (1.0 - cc.split) * d)
+}
+
+/// Kinetic energy [J] of a constraint's two bodies (a static side counts zero).
+fn pair_kinetic_energy(cc: &ContactConstraint, a: &BodyState, b: &BodyState) -> f32 {
+    let part = |inv_m: f32, inv_i: f32, s: &BodyState| {
+        let lin = if inv_m > 0.0 {
+            0.5 * s.v.length_squared() / inv_m
+        } else {
+            0.0
+        };
+        let ang = if inv_i > 0.0 { 0.5 * s.w * s.w / inv_i } else { 0.0 };
+        lin + ang
+    };
+    part(cc.inv_mass_a, cc.inv_i_a, a) + part(cc.inv_mass_b, cc.inv_i_b, b)
+}
+
+/// Relative velocity at a contact point, measured at the common point of [`lever_arms`].
+#[inline]
+fn point_velocity(cc: &ContactConstraint, a: &BodyState, b: &BodyState, r_a: Vec2, r_b: Vec2) -> Vec2 {
+    let (r_a, r_b) = lever_arms(cc, a, b, r_a, r_b);
+    relative_velocity(a, b, r_a, r_b)
+}
+
 /// Velocity of B's point minus A's point.
 #[inline]
 fn relative_velocity(a: &BodyState, b: &BodyState, r_a: Vec2, r_b: Vec2) -> Vec2 {
     (b.v + Vec2::cross_sv(b.w, r_b)) - (a.v + Vec2::cross_sv(a.w, r_a))
 }
 
-/// Applies the impulse `p` at the anchors: −p to A, +p to B.
+/// Applies the impulse `p` at the anchors' common point (see [`lever_arms`]): −p to A,
+/// +p to B.
 #[inline]
 fn apply(cc: &ContactConstraint, a: &mut BodyState, b: &mut BodyState, r_a: Vec2, r_b: Vec2, p: Vec2) {
+    let (r_a, r_b) = lever_arms(cc, a, b, r_a, r_b);
     a.v -= cc.inv_mass_a * p;
     a.w -= cc.inv_i_a * r_a.cross(p);
     b.v += cc.inv_mass_b * p;
@@ -432,8 +486,9 @@ impl ConstraintSet for ContactSolver {
             if cc.restitution > 0.0 {
                 // Impact speed for restitution: the approach velocity before this
                 // substep's impulses, whichever pass then catches the impact.
-                for cp in &mut cc.points[..cc.count] {
-                    cp.substep_vn = relative_velocity(&a, &b, cp.r_a, cp.r_b).dot(n);
+                for i in 0..cc.count {
+                    let (r_a, r_b) = (cc.points[i].r_a, cc.points[i].r_b);
+                    cc.points[i].substep_vn = point_velocity(cc, &a, &b, r_a, r_b).dot(n);
                 }
             }
             for cp in &cc.points[..cc.count] {
@@ -461,8 +516,9 @@ impl ConstraintSet for ContactSolver {
     fn record_approach(&mut self, states: &[BodyState]) {
         for cc in &mut self.constraints {
             let (a, b) = load(states, cc.index_a, cc.index_b);
-            for cp in &mut cc.points[..cc.count] {
-                cp.substep_vn = relative_velocity(&a, &b, cp.r_a, cp.r_b).dot(cc.normal);
+            for i in 0..cc.count {
+                let (r_a, r_b) = (cc.points[i].r_a, cc.points[i].r_b);
+                cc.points[i].substep_vn = point_velocity(cc, &a, &b, r_a, r_b).dot(cc.normal);
             }
         }
     }
@@ -514,13 +570,64 @@ impl ConstraintSet for ContactSolver {
             }
             let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
             let n = cc.normal;
-            for i in 0..cc.count {
-                let cp = cc.points[i];
-                if cp.approach > -cc.restitution_threshold || cp.max_normal_impulse == 0.0 {
+            let bounces = |p: &ConstraintPoint| p.approach <= -cc.restitution_threshold && p.max_normal_impulse > 0.0;
+            if cc.count == 2 && cc.block && bounces(&cc.points[0]) && bounces(&cc.points[1]) {
+                // Both points of a face bounce: solve them together, or the second point's
+                // impulse would add to the rebound the first already set (energy gain).
+                let mut rows = [NormalRow::default(); 2];
+                for (row, cp) in rows.iter_mut().zip(&cc.points) {
+                    *row = NormalRow {
+                        vn: point_velocity(cc, &a, &b, cp.r_a, cp.r_b).dot(n),
+                        bias: cc.restitution * cp.approach,
+                        mass_scale: 1.0,
+                        impulse_scale: 0.0,
+                    };
+                }
+                if let Some(x) = solve_block(cc, &rows) {
+                    for (i, &xi) in x.iter().enumerate() {
+                        let cp = cc.points[i];
+                        apply(cc, &mut a, &mut b, cp.r_a, cp.r_b, (xi - cp.normal_impulse) * n);
+                        let cp = &mut cc.points[i];
+                        cp.total_normal_impulse += xi - cp.normal_impulse;
+                        cp.normal_impulse = xi;
+                        cp.max_normal_impulse = cp.max_normal_impulse.max(xi);
+                    }
+                    store(states, cc.index_a, cc.index_b, a, b);
                     continue;
                 }
-                let vn = relative_velocity(&a, &b, cp.r_a, cp.r_b).dot(n);
-                let impulse = -cp.normal_mass * (vn + cc.restitution * cp.approach);
+            }
+            for i in 0..cc.count {
+                let cp = cc.points[i];
+                if !bounces(&cp) {
+                    continue;
+                }
+                let vn = point_velocity(cc, &a, &b, cp.r_a, cp.r_b).dot(n);
+                // Effective mass at the lever arms the impulse will act through now.
+                let (r_a, r_b) = lever_arms(cc, &a, &b, cp.r_a, cp.r_b);
+                let masses = Masses {
+                    ma: cc.inv_mass_a,
+                    ia: cc.inv_i_a,
+                    mb: cc.inv_mass_b,
+                    ib: cc.inv_i_b,
+                };
+                let normal_mass = inv_or_zero(effective_mass_inv(&masses, r_a, r_b, n));
+                let mut impulse = -normal_mass * (vn + cc.restitution * cp.approach);
+                // Never bounce back with more energy than the pair had before the step:
+                // along n the pair's energy is KE + λ·vn + λ²/(2 m_n); keep it ≤ KE₀.
+                // (The impact speed and the lever arms are sampled at slightly different
+                // moments of the step, which could otherwise add a little energy.)
+                if impulse > 0.0 && normal_mass > 0.0 {
+                    let ke = pair_kinetic_energy(cc, &a, &b);
+                    let room = cc.kinetic_energy - ke;
+                    // λ²/(2 m_n) + λ vn − room ≤ 0 → λ ≤ m_n (−vn + √(vn² + 2 room / m_n))
+                    let disc = vn * vn + 2.0 * room / normal_mass;
+                    let max = if disc > 0.0 {
+                        normal_mass * (-vn + disc.sqrt())
+                    } else {
+                        0.0
+                    };
+                    impulse = impulse.min(max.max(0.0));
+                }
                 let new = (cp.normal_impulse + impulse).max(0.0);
                 let delta = new - cp.normal_impulse;
                 apply(cc, &mut a, &mut b, cp.r_a, cp.r_b, delta * n);
@@ -555,7 +662,7 @@ fn solve_normals(cc: &mut ContactConstraint, a: &mut BodyState, b: &mut BodyStat
     let n = cc.normal;
     let mut rows = [NormalRow::default(); 2];
     for (row, cp) in rows.iter_mut().zip(&cc.points[..cc.count]) {
-        *row = normal_row(cp, a, b, n, ctx, use_bias);
+        *row = normal_row(cc, cp, a, b, ctx, use_bias);
     }
     let block = if cc.count == 2 && cc.block {
         solve_block(cc, &rows)
@@ -576,7 +683,7 @@ fn solve_normals(cc: &mut ContactConstraint, a: &mut BodyState, b: &mut BodyStat
                 let row = if i == 0 {
                     rows[0]
                 } else {
-                    normal_row(&cp, a, b, n, ctx, use_bias)
+                    normal_row(cc, &cp, a, b, ctx, use_bias)
                 };
                 let impulse = -cp.normal_mass * row.mass_scale * (row.vn + row.bias)
                     - row.impulse_scale * (cp.normal_impulse - cp.preload);
@@ -621,7 +728,7 @@ fn solve_friction(
         let stick = p0.stick && p1.stick;
         let mu = if stick { cc.mu_s } else { cc.mu_d };
         let limit = mu * (p0.normal_impulse + p1.normal_impulse);
-        let vt = relative_velocity(a, b, r_a, r_b).dot(t) - cc.tangent_speed;
+        let vt = point_velocity(cc, a, b, r_a, r_b).dot(t) - cc.tangent_speed;
         let bias = if use_bias && stick && limit > 0.0 {
             let d = anchor_displacement(a, b, r_a, r_b);
             let drift = d.dot(t) + 0.5 * (p0.base_drift + p1.base_drift) - cc.tangent_speed * elapsed;
@@ -646,7 +753,7 @@ fn solve_friction(
         let cp = cc.points[i];
         let mu = if cp.stick { cc.mu_s } else { cc.mu_d };
         let limit = mu * cp.normal_impulse;
-        let vt = relative_velocity(a, b, cp.r_a, cp.r_b).dot(t) - cc.tangent_speed;
+        let vt = point_velocity(cc, a, b, cp.r_a, cp.r_b).dot(t) - cc.tangent_speed;
         let bias = if use_bias && cp.stick && cp.normal_impulse > 0.0 {
             let d = anchor_displacement(a, b, cp.r_a, cp.r_b);
             let drift = d.dot(t) + cp.base_drift - cc.tangent_speed * elapsed;
@@ -714,7 +821,7 @@ pub(crate) fn store_impulses(cc: &ContactConstraint, contact: &mut Contact, stat
             0.0
         };
         ps.fresh = false;
-        let vt = relative_velocity(&a, &b, cp.r_a, cp.r_b).dot(t) - cc.tangent_speed;
+        let vt = point_velocity(cc, &a, &b, cp.r_a, cp.r_b).dot(t) - cc.tangent_speed;
         ps.slip_speed = vt.abs();
         let loaded = cp.max_normal_impulse > 0.0;
         let mut stick = cp.stick;
