@@ -87,7 +87,6 @@ fn conservation() {
 }
 
 #[test]
-#[ignore = "known failure: 100:1 heavy-on-light on a slope slides off (friction converges too slowly through the light box); see KNOWN_FAILURES"]
 fn mass_ratio_slope() {
     assert_checks(validation::mass_ratio_slope());
 }

@@ -37,10 +37,16 @@
 //! compresses. Here the soft row relaxes towards a *preload* `λ_pre` instead of towards 0:
 //! `Δλ = −m·s_m·(v + β·C) − s_i·(λ − λ_pre)`. The preload tracks the point's load slowly
 //! (a fraction [`PRELOAD_RATE`] of the gap per step), so a steady load needs no deflection
-//! while impacts and load changes still meet the damped spring. Between two moving bodies
-//! the preload follows the manifold's mean load (so the rocking mode of a stack stays a
-//! plain damped spring); against static bodies it follows each point's own load (so a box
-//! on a slope does not tilt into the ground).
+//! while impacts and load changes still meet the damped spring. Each point follows its
+//! own load, so a box on a slope does not tilt into the ground either. (With one sweep per
+//! point a per-point preload let tall towers rock; the 2×2 block normal solve below removed
+//! that coupling.)
+//!
+//! ## Mass ratios
+//! Sequential impulses move momentum through a light body squeezed between a heavy one and
+//! the ground at a rate of about m/M per sweep. Each light body that touches a moving body
+//! more than 4× heavier gets ⌈M/m⌉ (at most 64) extra sweeps over its own contacts in the
+//! relax pass (rigid rows, so repeated sweeps converge instead of softening).
 //!
 //! ## Block normal solve
 //! The two normal rows of a 2-point manifold are solved together (a 2×2 LCP, Box2D v2.4's
@@ -133,6 +139,10 @@ pub(crate) struct ConstraintBodies {
 #[derive(Default)]
 pub(crate) struct ContactSolver {
     pub constraints: Vec<ContactConstraint>,
+    /// Local groups for mass ratios: `groups[g]` is a range of `group_members`, the
+    /// constraints of one light body that carries a much heavier one.
+    groups: Vec<(u32, u32, u32)>,
+    group_members: Vec<u32>,
 }
 
 impl ContactSolver {
@@ -219,6 +229,51 @@ impl ContactSolver {
             }
         }
         self.constraints.push(cc);
+    }
+
+    /// Finds light bodies that touch a much heavier moving body and groups each one's
+    /// constraints for extra local sweeps. Sequential impulses move momentum through a
+    /// light body between a heavy one and the ground only at a rate of about m/M per
+    /// sweep, so a 100:1 stack needs ~100 sweeps where one is enough for equal masses.
+    /// Sweeps per pass: ⌈M/m⌉, capped at [`MAX_LOCAL_SWEEPS`].
+    fn build_mass_ratio_groups(&mut self) {
+        self.groups.clear();
+        self.group_members.clear();
+        let mut light: Vec<(u32, u32)> = Vec::new(); // (light body index, sweeps)
+        for cc in &self.constraints {
+            if cc.inv_mass_a > 0.0 && cc.inv_mass_b > 0.0 {
+                let (ratio, body) = if cc.inv_mass_a > cc.inv_mass_b {
+                    (cc.inv_mass_a / cc.inv_mass_b, cc.index_a)
+                } else {
+                    (cc.inv_mass_b / cc.inv_mass_a, cc.index_b)
+                };
+                if ratio > MASS_RATIO_GROUP {
+                    let sweeps = (ratio.ceil() as u32).min(MAX_LOCAL_SWEEPS);
+                    light.push((body, sweeps));
+                }
+            }
+        }
+        if light.is_empty() {
+            return;
+        }
+        light.sort_unstable();
+        light.dedup_by(|x, y| {
+            if x.0 == y.0 {
+                y.1 = y.1.max(x.1);
+                true
+            } else {
+                false
+            }
+        });
+        for &(body, sweeps) in &light {
+            let start = self.group_members.len() as u32;
+            for (ci, cc) in self.constraints.iter().enumerate() {
+                if cc.index_a == body || cc.index_b == body {
+                    self.group_members.push(ci as u32);
+                }
+            }
+            self.groups.push((start, self.group_members.len() as u32, sweeps));
+        }
     }
 
     /// Resolves per-point softness and the state of new points (prepare stage, part 2),
@@ -359,6 +414,12 @@ const ESTIMATE_ITERATIONS: usize = 128;
 /// Approach speed [m/s] below which a new touching contact counts as resting.
 const RESTING_SPEED: f32 = 0.5;
 
+/// Mass ratio above which a light body's constraints get extra local sweeps.
+const MASS_RATIO_GROUP: f32 = 4.0;
+
+/// Most extra local sweeps per pass for one light body.
+const MAX_LOCAL_SWEEPS: u32 = 64;
+
 /// Inverse masses of a constraint's bodies.
 struct Masses {
     ma: f32,
@@ -476,6 +537,7 @@ impl ConstraintSet for ContactSolver {
         // Geometry and masses were filled by `push`; softness and new points' states
         // need the body velocities.
         self.prepare_points(ctx, states);
+        self.build_mass_ratio_groups();
     }
 
     fn warm_start(&mut self, states: &mut [BodyState]) {
@@ -504,6 +566,19 @@ impl ConstraintSet for ContactSolver {
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, elapsed: f32) {
         for cc in &mut self.constraints {
             solve_one(cc, states, ctx, use_bias, elapsed);
+        }
+        // Extra local sweeps where a light body carries a heavy one, in the relax pass only:
+        // the soft rows of the biased pass are formulated for exactly one sweep (each
+        // sweep relaxes the impulse towards its preload).
+        if use_bias {
+            return;
+        }
+        for &(start, end, sweeps) in &self.groups {
+            for _ in 0..sweeps {
+                for &ci in &self.group_members[start as usize..end as usize] {
+                    solve_one(&mut self.constraints[ci as usize], states, ctx, use_bias, elapsed);
+                }
+            }
         }
     }
 
@@ -791,7 +866,6 @@ pub(crate) fn store_impulses(cc: &ContactConstraint, contact: &mut Contact, stat
     let (a, b) = load(states, cc.index_a, cc.index_b);
     let t = cc.normal.right_perp();
     contact.rolling_impulse = cc.rolling_impulse;
-    let mean = cc.points[..cc.count].iter().map(|p| p.normal_impulse).sum::<f32>() / cc.count.max(1) as f32;
     // A face contact slides as a whole: its points turn to Slip only when the manifold's
     // total friction reached μs times its total normal impulse (PhysX's per-patch
     // "broken" flag), not when sequential solving happened to load one point to its
@@ -807,13 +881,8 @@ pub(crate) fn store_impulses(cc: &ContactConstraint, contact: &mut Contact, stat
         ps.total_tangent_impulse = cp.total_tangent_impulse;
         ps.max_normal_impulse = cp.max_normal_impulse;
         ps.approach_velocity = cp.approach;
-        // Preload tracking (module docs): per point against static bodies, the manifold
-        // mean between two moving bodies; a new point starts at its first load.
-        let target = if cc.index_a == 0 || cc.index_b == 0 {
-            cp.normal_impulse
-        } else {
-            mean
-        };
+        // Preload tracking (module docs); a new point starts at its first load.
+        let target = cp.normal_impulse;
         let rate = if cp.fresh { 1.0 } else { PRELOAD_RATE };
         ps.preload = if cp.max_normal_impulse > 0.0 {
             cp.preload + rate * (target - cp.preload)
