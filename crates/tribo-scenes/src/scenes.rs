@@ -153,7 +153,7 @@ fn ground(name: &str, half_width: f32, top: f32, material: Option<MaterialRef>) 
 
 /// Three blocks on a slope with μd < tan θ < μs.
 pub fn incline() -> SceneFile {
-    let mut s = scene("incline: μs = 0.6, μd = 0.4, tan θ = 0.5", 240);
+    let mut s = scene("incline: μs = 0.6, μd = 0.4, tan θ = 0.5", 180);
     s.materials.insert("wood".into(), mat(0.6, 0.4));
     s.materials.insert("one_mu".into(), mat(0.4, 0.4));
     let angle = 0.5f32.atan();
@@ -162,14 +162,14 @@ pub fn incline() -> SceneFile {
         BodyKind::Static,
         rotate([0.0, -1.0], angle),
         angle,
-        vec![box_shape(12.0, 1.0, named("wood"))],
+        vec![box_shape(20.0, 1.0, named("wood"))],
     );
     slope.angle = angle;
     s.bodies.push(slope);
     let blocks = [
-        ("at_rest", 6.0, 0.0, "wood"),
-        ("pushed", 3.0, 1.5, "wood"),
-        ("one_mu", 0.0, 0.0, "one_mu"),
+        ("at_rest", 16.0, 0.0, "wood"),
+        ("pushed", 12.0, 1.5, "wood"),
+        ("one_mu", -2.0, 0.0, "one_mu"),
     ];
     for (name, along, push, material) in blocks {
         let mut b = body(
@@ -179,8 +179,10 @@ pub fn incline() -> SceneFile {
             angle,
             vec![box_shape(0.5, 0.5, named(material))],
         );
-        let down = rotate([-1.0, 0.0], angle);
-        b.linear_velocity = [down[0] * push, down[1] * push];
+        if push != 0.0 {
+            let down = rotate([-1.0, 0.0], angle);
+            b.linear_velocity = [down[0] * push, down[1] * push];
+        }
         s.bodies.push(b);
     }
     s

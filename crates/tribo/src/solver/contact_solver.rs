@@ -874,11 +874,20 @@ pub(crate) fn store_impulses(cc: &ContactConstraint, contact: &mut Contact, stat
         (t + p.tangent_impulse, n + p.normal_impulse)
     });
     let patch_saturated = sum_t.abs() >= 0.999 * cc.mu_s * sum_n && cc.points[..cc.count].iter().any(|p| p.saturated);
+    let sum_total_t: f32 = cc.points[..cc.count].iter().map(|p| p.total_tangent_impulse).sum();
+    let sum_total_n: f32 = cc.points[..cc.count].iter().map(|p| p.total_normal_impulse).sum();
     for (cp, ps) in cc.points[..cc.count].iter().zip(contact.points.iter_mut()) {
         ps.normal_impulse = cp.normal_impulse;
         ps.tangent_impulse = cp.tangent_impulse;
         ps.total_normal_impulse = cp.total_normal_impulse;
-        ps.total_tangent_impulse = cp.total_tangent_impulse;
+        // A face contact's friction is one patch row (split evenly inside the solver, which
+        // is the same as acting at the middle); report it split in proportion to the
+        // points' normal impulses, so each point shows |f| ≤ μ·n like the patch does.
+        ps.total_tangent_impulse = if cc.count == 2 && sum_total_n > 0.0 {
+            sum_total_t * cp.total_normal_impulse / sum_total_n
+        } else {
+            cp.total_tangent_impulse
+        };
         ps.max_normal_impulse = cp.max_normal_impulse;
         ps.approach_velocity = cp.approach;
         // Preload tracking (module docs); a new point starts at its first load.
