@@ -112,6 +112,7 @@ pub const EXPERIMENTS: &[Experiment] = &[
     ("slide_to_rest", slide_to_rest),
     ("pull", pull),
     ("slip_to_roll", slip_to_roll),
+    ("rolling_resistance", rolling_resistance),
     ("restitution", restitution),
     ("conveyor", conveyor),
     ("combine_rules", combine_rules),
@@ -400,6 +401,46 @@ pub fn slip_to_roll() -> Result<Vec<Check>> {
             "s",
         ),
     ])
+}
+
+/// A disk rolling without slip on flat ground under rolling resistance c (Box2D's model:
+/// the resisting torque is at most c·R·N) decelerates at a = (2/3)·c·g: from m·a = −f and
+/// I·α = f·R − c·R·m·g with a = α·R and I = m·R²/2. It stops after d = v0² / (2a).
+pub fn rolling_resistance() -> Result<Vec<Check>> {
+    let (v0, r, c) = (2.0f32, 0.5f32, 0.05f32);
+    let m = Material {
+        rolling_resistance: c,
+        ..Material::default().friction(0.8, 0.6)
+    };
+    let mut world = build::world_no_sleep(G)?;
+    build::flat_ground(&mut world, 50.0, Material::default().friction(0.8, 0.6))?;
+    let mut def = BodyDef::dynamic(Vec2::new(0.0, r));
+    def.linear_velocity = Vec2::new(v0, 0.0);
+    def.angular_velocity = -v0 / r;
+    let disk = build::dynamic_disk(&mut world, def, r, m)?;
+    let a = 2.0 / 3.0 * c as f64 * G as f64;
+    let t_stop = v0 as f64 / a;
+    let mut series = Vec::new();
+    for k in 1..=steps(t_stop as f32 + 1.0) {
+        world.step(DT)?;
+        let t = k as f64 * DT as f64;
+        series.push((
+            t,
+            world.body_linear_velocity(disk)?.x as f64,
+            (v0 as f64 - a * t).max(0.0),
+        ));
+    }
+    let d = world.body_position(disk)?.x as f64;
+    Ok(vec![Check::new(
+        "rolling_resistance",
+        "rolling disk, c = 0.05: stopping distance d = v0² / (2 · (2/3) c g)",
+        (v0 as f64).powi(2) / (2.0 * a),
+        d,
+        // 2 %: as for sliding to rest (start and stop each fall inside one step).
+        Tolerance::Relative(0.02),
+        "m",
+    )
+    .with_series(series)])
 }
 
 /// Drops a ball of radius 0.25 from a height h (bottom above ground) and returns the

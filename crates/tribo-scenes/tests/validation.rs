@@ -57,6 +57,11 @@ fn slip_to_roll() {
 }
 
 #[test]
+fn rolling_resistance() {
+    assert_checks(validation::rolling_resistance());
+}
+
+#[test]
 fn restitution() {
     assert_checks(validation::restitution());
 }
