@@ -320,3 +320,29 @@ fn bad_flags_are_rejected_before_any_output() {
     let out = tribo(&["run", "incline", "--render", s(&dir.join("p.bmp"))]);
     assert_eq!(out.status.code(), Some(1));
 }
+
+#[test]
+fn validate_prints_the_table_and_writes_a_self_contained_report() {
+    let dir = tmp_dir("validate");
+    let report = dir.join("report");
+    let out = tribo(&["validate", "--report", s(&report)]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("incline_stick") && stdout.contains("slip_to_roll"));
+    let summary = stdout
+        .lines()
+        .rev()
+        .find(|l| l.contains("passed"))
+        .expect("summary line");
+    assert!(summary.ends_with(", 0 failed"), "{summary}");
+    let html = std::fs::read_to_string(report.join("index.html")).expect("report");
+    assert!(html.contains("<svg") && html.contains("data:image/png;base64,"));
+    assert!(
+        !html.contains("http://") && !html.contains("https://"),
+        "report must not need the network"
+    );
+}

@@ -272,6 +272,7 @@ impl World {
         // bodies, so the ground has the last word in each pass (as Box2D's colouring does).
         let mut solver = core::mem::take(&mut self.contact_solver);
         solver.constraints.clear();
+        solver.up = (-g).normalize_or_zero();
         for pass_static in [false, true] {
             for (ci, slot) in self.contacts.iter().enumerate() {
                 let Some(c) = slot else { continue };
