@@ -267,31 +267,27 @@ impl Camera {
     }
 
     /// Picture width [px].
+    #[cfg(test)]
     pub fn width(&self) -> u32 {
         self.width
     }
 
     /// Picture height [px].
+    #[cfg(test)]
     pub fn height(&self) -> u32 {
         self.height
     }
 
     /// Pixels per metre.
+    #[cfg(test)]
     pub fn pixels_per_metre(&self) -> f32 {
         self.scale
     }
 
     /// World point [m] shown at the centre of the picture.
+    #[cfg(test)]
     pub fn center(&self) -> [f32; 2] {
         self.center
-    }
-
-    /// The same view at another picture size (scale adapted so the same
-    /// world width is shown).
-    pub fn resized(&self, width: u32, height: u32) -> Camera {
-        let width = width.max(1);
-        let factor = width as f32 / self.width as f32;
-        Camera::new(self.center, self.scale * factor, width, height)
     }
 
     /// Pixel position of a world point [m].
