@@ -631,6 +631,11 @@ impl SceneFile {
                 world
                     .set_body_linear_velocity(id, def.linear_velocity)
                     .map_err(to_err(format!("{p}.linear_velocity")))?;
+                // Setting a velocity wakes a body: put one created asleep back to sleep
+                // (alone, as Box2D creates each sleeping body in its own set).
+                if !b.awake {
+                    world.set_body_awake(id, false).map_err(to_err(format!("{p}.awake")))?;
+                }
             }
             bodies.push(id);
         }

@@ -517,3 +517,26 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod sleep_tests {
+    use crate::format::{BodyKind, BodySpec, SceneFile};
+
+    /// A body the scene creates asleep stays asleep after building (regression: setting
+    /// its velocity used to wake it).
+    #[test]
+    fn bodies_created_asleep_stay_asleep() {
+        let mut scene = super::bounce();
+        scene.bodies.push(BodySpec {
+            kind: BodyKind::Dynamic,
+            position: [8.0, 5.0],
+            awake: false,
+            gravity_scale: 1.0,
+            shapes: vec![super::box_shape(0.5, 0.5, None)],
+            ..BodySpec::default()
+        });
+        let built = SceneFile::build(&scene).expect("builds");
+        let id = *built.bodies.last().expect("body");
+        assert!(!built.world.body_is_awake(id).expect("live"));
+    }
+}
