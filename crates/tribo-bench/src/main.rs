@@ -1,0 +1,466 @@
+//! `tribo-bench`: times Tribo, Box2D v3 (boxdd) and Rapier side by side, in one process,
+//! on Box2D v3's benchmark scenes (shared/SCENES.md §1–§2).
+//!
+//! Timing loop (SCENES.md §1): build the scene (untimed); one untimed step; time steps
+//! 1 … N−1; repeat for R runs. Runs are interleaved (run 1 of every engine, then run 2, …)
+//! so background noise spreads over all engines. Reported: ms/step median and min over runs.
+//!
+//! Build Box2D with release C flags: `CFLAGS="-O3 -DNDEBUG"` (see run.sh).
+
+mod engines;
+mod scenes;
+
+use clap::Parser;
+use engines::{BoxError, EngineKind, Sim};
+use scenes::{BenchScene, CheckKind, SCENES};
+use serde_json::json;
+use std::io::Write;
+use std::time::Instant;
+use tribo_scenes::format::{BodyKind, SceneFile};
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "tribo-bench",
+    about = "Tribo vs Box2D v3 vs Rapier on Box2D's benchmark scenes"
+)]
+struct Args {
+    /// Scene to run: large_pyramid, many_pyramids, smash, or all.
+    #[arg(default_value = "all", value_name = "SCENE")]
+    scene_pos: String,
+    /// Same as the positional SCENE (overrides it).
+    #[arg(long)]
+    scene: Option<String>,
+    /// Runs per engine and scene (median and min are over these).
+    #[arg(long, default_value_t = 5)]
+    runs: usize,
+    /// Override the scene's step count N (N−1 steps are timed); for smoke runs.
+    #[arg(long)]
+    steps: Option<u32>,
+    /// Worker threads for Box2D (workerCount) and Rapier (its rayon pool, only with the
+    /// `rapier-parallel` feature). Tribo is single-threaded and always reports 1.
+    #[arg(long, default_value_t = 1)]
+    threads: usize,
+    /// Engines to time, comma separated (tribo, box2d, rapier).
+    #[arg(long, default_value = "tribo,box2d,rapier", value_delimiter = ',')]
+    engines: Vec<String>,
+    /// Skip the second table (Tribo with μs = 1.5 μd).
+    #[arg(long)]
+    no_friction_table: bool,
+    /// Write one JSON line per (scene, engine) to this file ("-" = stdout).
+    #[arg(long)]
+    json: Option<String>,
+    /// Print each engine's per-stage profile (sampling adds a little time to each step).
+    #[arg(long)]
+    profile: bool,
+}
+
+/// Result of the stability check of one run.
+#[derive(Clone, Debug)]
+struct Check {
+    passed: bool,
+    text: String,
+    json: serde_json::Value,
+}
+
+/// Everything measured for one (scene, engine).
+struct EngineResult {
+    kind: EngineKind,
+    ms: Vec<f64>,
+    build_s: Vec<f64>,
+    check: Option<Check>,
+    all_passed: bool,
+    threads: usize,
+    contacts: usize,
+    profile: String,
+}
+
+impl EngineResult {
+    fn median(&self) -> f64 {
+        let mut v = self.ms.clone();
+        v.sort_by(|a, b| a.total_cmp(b));
+        let n = v.len();
+        if n == 0 {
+            f64::NAN
+        } else if n % 2 == 1 {
+            v[n / 2]
+        } else {
+            0.5 * (v[n / 2 - 1] + v[n / 2])
+        }
+    }
+    fn min(&self) -> f64 {
+        self.ms.iter().copied().fold(f64::INFINITY, f64::min)
+    }
+}
+
+fn main() {
+    let args = Args::parse();
+    if let Err(e) = run(&args) {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    }
+}
+
+fn run(args: &Args) -> Result<(), BoxError> {
+    let scene_name = args.scene.clone().unwrap_or_else(|| args.scene_pos.clone());
+    let selected: Vec<&BenchScene> = if scene_name == "all" {
+        SCENES.iter().collect()
+    } else {
+        let s = SCENES.iter().find(|s| s.name == scene_name).ok_or_else(|| {
+            let names: Vec<&str> = SCENES.iter().map(|s| s.name).collect();
+            format!("unknown scene {scene_name} (known: {}, all)", names.join(", "))
+        })?;
+        vec![s]
+    };
+    let mut kinds = Vec::new();
+    for e in &args.engines {
+        kinds.push(match e.as_str() {
+            "tribo" => EngineKind::Tribo,
+            "box2d" => EngineKind::Box2d,
+            "rapier" => EngineKind::Rapier,
+            other => return Err(format!("unknown engine {other} (tribo, box2d, rapier)").into()),
+        });
+    }
+    if !args.no_friction_table && kinds.contains(&EngineKind::Tribo) {
+        kinds.push(EngineKind::TriboMus15);
+    }
+    if args.runs == 0 {
+        return Err("--runs must be at least 1".into());
+    }
+    if args.threads == 0 {
+        return Err("--threads must be at least 1".into());
+    }
+    let mut json_out: Option<Box<dyn Write>> = match args.json.as_deref() {
+        None => None,
+        Some("-") => Some(Box::new(std::io::stdout())),
+        Some(path) => Some(Box::new(std::fs::File::create(path)?)),
+    };
+
+    print_header(args);
+    let mut all_results = Vec::new();
+    for bench in selected {
+        let mut scene = (bench.build)();
+        if let Some(n) = args.steps {
+            scene.steps = n.max(2);
+        }
+        let results = run_scene(bench, &scene, &kinds, args)?;
+        print_scene_table(bench, &scene, &results, args);
+        if let Some(out) = json_out.as_mut() {
+            for r in &results {
+                let line = json!({
+                    "scene": bench.name,
+                    "engine": r.kind.name(),
+                    "threads": r.threads,
+                    "runs": r.ms.len(),
+                    "steps": scene.steps,
+                    "timed_steps": scene.steps - 1,
+                    "ms_per_step_median": r.median(),
+                    "ms_per_step_min": r.min(),
+                    "ms_per_step_runs": r.ms,
+                    "build_s_median": median(&r.build_s),
+                    "check_passed": r.all_passed,
+                    "check": r.check.as_ref().map(|c| c.json.clone()),
+                    "contacts": r.contacts,
+                    "bodies": scene.bodies.len(),
+                });
+                writeln!(out, "{line}")?;
+            }
+        }
+        all_results.push((bench.name, results));
+    }
+    if kinds.contains(&EngineKind::TriboMus15) {
+        print_friction_table(&all_results);
+    }
+    Ok(())
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut v = v.to_vec();
+    v.sort_by(|a, b| a.total_cmp(b));
+    if v.is_empty() {
+        f64::NAN
+    } else {
+        v[v.len() / 2]
+    }
+}
+
+fn print_header(args: &Args) {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into());
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(0);
+    let b2 = boxdd::Foundation::initialize_default()
+        .and_then(|_| boxdd::version())
+        .map(|v| format!("{}.{}.{}", v.major, v.minor, v.revision));
+    println!("tribo-bench: CPU {cpu}, {cores} cores available");
+    println!(
+        "Box2D {} via boxdd 0.6 (C flags from CFLAGS: \"{}\"), Rapier 0.36 ({}), Rust profile {}",
+        b2.unwrap_or_else(|_| "?".into()),
+        env!("TRIBO_BENCH_CFLAGS"),
+        if cfg!(feature = "rapier-parallel") {
+            "parallel feature on"
+        } else {
+            "serial build"
+        },
+        env!("TRIBO_BENCH_PROFILE"),
+    );
+    println!(
+        "runs {}, threads {} (Tribo is single-threaded: always 1){}",
+        args.runs,
+        args.threads,
+        if args.steps.is_some() {
+            ", step count overridden"
+        } else {
+            ""
+        }
+    );
+    if env!("TRIBO_BENCH_PROFILE") != "release" {
+        println!("WARNING: not a release build; timings are meaningless");
+    }
+    if !env!("TRIBO_BENCH_CFLAGS").contains("NDEBUG") {
+        println!("WARNING: Box2D built without -DNDEBUG (asserts on, boxdd-sys default -O2)");
+    }
+    println!();
+}
+
+fn run_scene(
+    bench: &BenchScene,
+    scene: &SceneFile,
+    kinds: &[EngineKind],
+    args: &Args,
+) -> Result<Vec<EngineResult>, BoxError> {
+    let mut results: Vec<EngineResult> = kinds
+        .iter()
+        .map(|&kind| EngineResult {
+            kind,
+            ms: Vec::new(),
+            build_s: Vec::new(),
+            check: None,
+            all_passed: true,
+            threads: 1,
+            contacts: 0,
+            profile: String::new(),
+        })
+        .collect();
+    let timed = scene.steps - 1;
+    for run in 0..args.runs {
+        for r in results.iter_mut() {
+            let t_build = Instant::now();
+            let mut sim = engines::build(r.kind, scene, args.threads)?;
+            let build_s = t_build.elapsed().as_secs_f64();
+            let awake_at_build = sim.awake_count();
+            sim.step()?; // untimed first step (index 0)
+            let awake_after_first = sim.awake_count();
+            let t0 = Instant::now();
+            if args.profile {
+                for _ in 0..timed {
+                    sim.step()?;
+                    sim.profile_sample();
+                }
+            } else {
+                for _ in 0..timed {
+                    sim.step()?;
+                }
+            }
+            let ms = t0.elapsed().as_secs_f64() * 1000.0 / timed as f64;
+            let check = check(bench, scene, sim.as_mut());
+            eprintln!(
+                "  {} run {}/{} {:<13} {:>9.3} ms/step (build {:.2} s; awake bodies at build/after step 0/end: {}/{}/{}) {}",
+                bench.name,
+                run + 1,
+                args.runs,
+                r.kind.name(),
+                ms,
+                build_s,
+                awake_at_build,
+                awake_after_first,
+                sim.awake_count(),
+                if check.passed { "ok" } else { "CHECK FAILED" }
+            );
+            r.ms.push(ms);
+            r.build_s.push(build_s);
+            r.all_passed &= check.passed;
+            r.threads = sim.threads();
+            r.contacts = sim.contact_count();
+            if args.profile {
+                r.profile = sim.profile_report();
+            }
+            r.check = Some(check);
+        }
+    }
+    Ok(results)
+}
+
+/// Pyramids: the top box(es) — the dynamic bodies of highest initial y (all pyramids'
+/// tops in the highest row for many_pyramids) — must drop less than 10 mm per stacked
+/// layer (1.0 m for large_pyramid's 100 layers, 0.1 m for many_pyramids' 10: each resting
+/// contact of a soft-contact solver may keep up to the 5 mm linear slop as penetration, so
+/// a correct engine's top box sinks up to ~5 mm per layer; a collapse drops metres) and
+/// drift less than 0.5 m sideways. Smash: the projectile must have hit and ploughed into the block
+/// (final x in (30, 180) m, final speed in (1, 39) m/s; 180 m and 40 m/s would mean it
+/// passed through untouched) and total linear momentum must be conserved within 1 %
+/// (no gravity, no static bodies). Every dynamic body's position must stay finite.
+fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
+    let dynamic: Vec<usize> = (0..scene.bodies.len())
+        .filter(|&i| scene.bodies[i].kind == BodyKind::Dynamic)
+        .collect();
+    let mut finite = true;
+    let mut max_disp = 0.0f32;
+    for &i in &dynamic {
+        let p = sim.position(i);
+        let p0 = scene.bodies[i].position;
+        if !(p[0].is_finite() && p[1].is_finite()) {
+            finite = false;
+        } else {
+            max_disp = max_disp.max(((p[0] - p0[0]).powi(2) + (p[1] - p0[1]).powi(2)).sqrt());
+        }
+    }
+    match bench.check {
+        CheckKind::Pyramid => {
+            let max_drop = 0.01 * bench.stack_layers as f32;
+            let y_top = dynamic
+                .iter()
+                .map(|&i| scene.bodies[i].position[1])
+                .fold(f32::NEG_INFINITY, f32::max);
+            let tops: Vec<usize> = dynamic
+                .iter()
+                .copied()
+                .filter(|&i| scene.bodies[i].position[1] >= y_top - 1e-3)
+                .collect();
+            let (mut drop, mut drift) = (0.0f32, 0.0f32);
+            for &i in &tops {
+                let p = sim.position(i);
+                let p0 = scene.bodies[i].position;
+                let d = p0[1] - p[1];
+                if d.abs() > drop.abs() || d.is_nan() {
+                    drop = d;
+                }
+                drift = drift.max((p[0] - p0[0]).abs());
+            }
+            let passed = finite && drop.abs() < max_drop && drift < 0.5;
+            Check {
+                passed,
+                text: format!(
+                    "top drop {:.4} m (< {:.2}), drift {:.4} m (< 0.5) ({} top box{}); max |Δp| any box {:.3} m",
+                    drop,
+                    max_drop,
+                    drift,
+                    tops.len(),
+                    if tops.len() == 1 { "" } else { "es" },
+                    max_disp
+                ),
+                json: json!({"top_drop_m": drop, "top_drop_limit_m": max_drop, "top_drift_m": drift, "tops": tops.len(),
+                             "max_displacement_m": max_disp, "finite": finite}),
+            }
+        }
+        CheckKind::Smash => {
+            let proj = scene
+                .bodies
+                .iter()
+                .position(|b| b.name.as_deref() == Some("projectile"))
+                .unwrap_or(dynamic[0]);
+            let p = sim.position(proj);
+            let v = sim.velocity(proj);
+            let speed = (v[0] * v[0] + v[1] * v[1]).sqrt();
+            let (mut p0, mut p1) = ([0.0f64; 2], [0.0f64; 2]);
+            for &i in &dynamic {
+                let m = sim.mass(i) as f64;
+                let v0 = scene.bodies[i].linear_velocity;
+                let v1 = sim.velocity(i);
+                p0[0] += m * v0[0] as f64;
+                p0[1] += m * v0[1] as f64;
+                p1[0] += m * v1[0] as f64;
+                p1[1] += m * v1[1] as f64;
+            }
+            let p0n = (p0[0] * p0[0] + p0[1] * p0[1]).sqrt();
+            let err = ((p1[0] - p0[0]).powi(2) + (p1[1] - p0[1]).powi(2)).sqrt() / p0n.max(1e-9);
+            let passed = finite && p[0] > 30.0 && p[0] < 180.0 && speed > 1.0 && speed < 39.0 && err < 0.01;
+            Check {
+                passed,
+                text: format!(
+                    "projectile x {:.2} m, speed {:.2} m/s; momentum error {:.2e}",
+                    p[0], speed, err
+                ),
+                json: json!({"projectile_x_m": p[0], "projectile_speed_m_s": speed,
+                             "momentum_rel_error": err, "finite": finite}),
+            }
+        }
+    }
+}
+
+fn print_scene_table(bench: &BenchScene, scene: &SceneFile, results: &[EngineResult], args: &Args) {
+    let dynamic = scene.bodies.iter().filter(|b| b.kind == BodyKind::Dynamic).count();
+    println!(
+        "== {}: {} dynamic bodies, {} steps ({} timed), {} runs, sleep {}",
+        bench.name,
+        dynamic,
+        scene.steps,
+        scene.steps - 1,
+        results.first().map_or(0, |r| r.ms.len()),
+        if scene.enable_sleep { "on" } else { "off" }
+    );
+    let tribo = results.iter().find(|r| r.kind == EngineKind::Tribo);
+    println!(
+        "{:<8} {:>7} {:>14} {:>11} {:>14} {:>11} {:>9}  check (last run)",
+        "engine", "threads", "median ms/step", "min ms/step", "Tribo/peer med", "Tribo/peer min", "contacts"
+    );
+    for r in results.iter().filter(|r| r.kind != EngineKind::TriboMus15) {
+        let (rm, rn) = match tribo {
+            Some(t) => (
+                format!("{:.2}", t.median() / r.median()),
+                format!("{:.2}", t.min() / r.min()),
+            ),
+            None => ("-".into(), "-".into()),
+        };
+        let check = r.check.as_ref().map_or(String::new(), |c| c.text.clone());
+        println!(
+            "{:<8} {:>7} {:>14.3} {:>11.3} {:>14} {:>11} {:>9}  {} {}",
+            r.kind.name(),
+            r.threads,
+            r.median(),
+            r.min(),
+            rm,
+            rn,
+            r.contacts,
+            if r.all_passed { "PASS" } else { "FAIL" },
+            check
+        );
+    }
+    if args.profile {
+        for r in results {
+            println!("  profile {}: {}", r.kind.name(), r.profile);
+        }
+    }
+    println!();
+}
+
+fn print_friction_table(all: &[(&str, Vec<EngineResult>)]) {
+    println!("== Tribo: cost of the static/dynamic friction model (every shape's μs scaled by 1.5, μd unchanged)");
+    println!(
+        "{:<14} {:>16} {:>18} {:>8} {:>14} {:>16}  check μs = 1.5 μd (last run)",
+        "scene", "μs=μd median ms", "μs=1.5μd median ms", "ratio", "μs=μd min ms", "μs=1.5μd min ms"
+    );
+    for (name, results) in all {
+        let a = results.iter().find(|r| r.kind == EngineKind::Tribo);
+        let b = results.iter().find(|r| r.kind == EngineKind::TriboMus15);
+        if let (Some(a), Some(b)) = (a, b) {
+            println!(
+                "{:<14} {:>16.3} {:>18.3} {:>8.3} {:>14.3} {:>16.3}  {} {}",
+                name,
+                a.median(),
+                b.median(),
+                b.median() / a.median(),
+                a.min(),
+                b.min(),
+                if b.all_passed { "PASS" } else { "FAIL" },
+                b.check.as_ref().map_or(String::new(), |c| c.text.clone())
+            );
+        }
+    }
+    println!("(ratio = μs=1.5μd / μs=μd, medians)");
+}

@@ -1,0 +1,154 @@
+//! The benchmark scenes (engine-neutral [`SceneFile`]s) and scene transformations.
+//!
+//! `large_pyramid` and `many_pyramids` come from `tribo_scenes::scenes`; `smash` is built
+//! here following shared/SCENES.md §2 (Box2D v3's `CreateSmash`).
+
+use tribo_scenes::format::{BodyKind, BodySpec, MaterialRef, MaterialSpec, SceneFile, ShapeSpec};
+
+/// What the stability check of a scene looks at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CheckKind {
+    /// Top box(es) must neither drop (more than 10 mm per stacked layer, i.e. twice Box2D's
+    /// 5 mm linear slop that each resting contact may keep as penetration) nor drift
+    /// sideways by 0.5 m or more.
+    Pyramid,
+    /// The projectile must hit and plough into the block; momentum is conserved.
+    Smash,
+}
+
+/// A benchmark scene.
+pub struct BenchScene {
+    /// Name on the command line and in the JSON.
+    pub name: &'static str,
+    /// Builds the scene.
+    pub build: fn() -> SceneFile,
+    /// Which check applies.
+    pub check: CheckKind,
+    /// Boxes stacked under (and including) the top box, for the pyramid check's drop limit.
+    pub stack_layers: u32,
+}
+
+/// Every benchmark scene, in the order `all` runs them.
+pub const SCENES: &[BenchScene] = &[
+    BenchScene {
+        name: "large_pyramid",
+        build: tribo_scenes::scenes::large_pyramid,
+        check: CheckKind::Pyramid,
+        stack_layers: 100,
+    },
+    BenchScene {
+        name: "many_pyramids",
+        build: tribo_scenes::scenes::many_pyramids,
+        check: CheckKind::Pyramid,
+        stack_layers: 10,
+    },
+    BenchScene {
+        name: "smash",
+        build: smash,
+        check: CheckKind::Smash,
+        stack_layers: 0,
+    },
+];
+
+fn box_shape(hx: f32, hy: f32, material: MaterialSpec) -> ShapeSpec {
+    ShapeSpec {
+        kind: "box".into(),
+        half_extents: Some([hx, hy]),
+        material: Some(MaterialRef::Inline(material)),
+        ..ShapeSpec::default()
+    }
+}
+
+fn dynamic_body(name: Option<String>, position: [f32; 2], shapes: Vec<ShapeSpec>) -> BodySpec {
+    BodySpec {
+        name,
+        kind: BodyKind::Dynamic,
+        position,
+        gravity_scale: 1.0,
+        awake: true,
+        shapes,
+        ..BodySpec::default()
+    }
+}
+
+/// Box2D v3's `smash` benchmark scene (SCENES.md §2): no gravity; a heavy box (half 4×4,
+/// density 8) at (−20, 0) moving at 40 m/s into a block of 120 × 80 small boxes (half
+/// 0.2 × 0.2, density 1, friction 0.6) created asleep. 300 steps, sleep on.
+pub fn smash() -> SceneFile {
+    let mut s = SceneFile {
+        description: Some("Box2D v3 benchmark smash".into()),
+        gravity: [0.0, 0.0],
+        dt: 1.0 / 60.0,
+        substeps: 4,
+        steps: 300,
+        enable_sleep: true,
+        materials: Default::default(),
+        bodies: Vec::with_capacity(1 + 120 * 80),
+    };
+    // Box2D shape defaults: friction 0.6, restitution 0, density 1.
+    let projectile_material = MaterialSpec {
+        density: Some(8.0),
+        friction: Some(0.6),
+        ..MaterialSpec::default()
+    };
+    let mut projectile = dynamic_body(
+        Some("projectile".into()),
+        [-20.0, 0.0],
+        vec![box_shape(4.0, 4.0, projectile_material)],
+    );
+    projectile.linear_velocity = [40.0, 0.0];
+    s.bodies.push(projectile);
+    let target_material = MaterialSpec {
+        density: Some(1.0),
+        friction: Some(0.6),
+        ..MaterialSpec::default()
+    };
+    for i in 0..120 {
+        for j in 0..80 {
+            let x = 30.0 + 0.4 * i as f32;
+            let y = 0.4 * (j as f32 - 40.0);
+            let mut b = dynamic_body(None, [x, y], vec![box_shape(0.2, 0.2, target_material.clone())]);
+            b.awake = false;
+            s.bodies.push(b);
+        }
+    }
+    s
+}
+
+/// The scene with every shape's static friction scaled by `factor` (μd unchanged): every
+/// shape gets its resolved material written in place with μs = factor · μs.
+pub fn scale_static_friction(scene: &SceneFile, factor: f32) -> SceneFile {
+    let mut out = scene.clone();
+    for body in &mut out.bodies {
+        for shape in &mut body.shapes {
+            let mut m = scene.shape_material(shape);
+            m.friction_static *= factor;
+            shape.material = Some(MaterialRef::Inline(MaterialSpec::from_material(&m)));
+        }
+    }
+    out.materials.clear();
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn smash_matches_scenes_md() {
+        let s = smash();
+        assert!(s.validate().is_ok());
+        assert_eq!(s.bodies.len(), 9601);
+        assert_eq!(s.bodies.iter().filter(|b| !b.awake).count(), 9600);
+        let m = s.shape_material(&s.bodies[0].shapes[0]);
+        assert_eq!((m.density, m.friction_static, m.friction_dynamic), (8.0, 0.6, 0.6));
+    }
+
+    #[test]
+    fn scaling_keeps_dynamic_friction() {
+        let s = scale_static_friction(&tribo_scenes::scenes::large_pyramid(), 1.5);
+        assert!(s.validate().is_ok());
+        let m = s.shape_material(&s.bodies[1].shapes[0]);
+        assert!((m.friction_static - 0.9).abs() < 1e-6 && (m.friction_dynamic - 0.6).abs() < 1e-6);
+    }
+}
