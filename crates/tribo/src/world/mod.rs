@@ -22,7 +22,7 @@ use crate::dynamics::shape::ShapeRecord;
 use crate::dynamics::{BodyDef, BodyType, Filter, Material, ShapeDef};
 use crate::error::{check_finite, check_non_negative, check_positive, check_vec, Error, Result};
 use crate::geometry::{Shape, SPECULATIVE_DISTANCE};
-use crate::math::{Aabb, Rot, Transform, Vec2};
+use crate::math::{Aabb, Transform, Vec2};
 use crate::solver::contact_solver::ContactSolver;
 use crate::solver::{BodySim, BodyState};
 
@@ -617,20 +617,11 @@ impl World {
     /// Keeps the origin fixed; the centre-of-mass velocity follows the moved centre.
     pub(crate) fn update_mass(&mut self, body_index: u32) {
         let Some(b) = self.bodies.at(body_index) else { return };
-        let shapes: Vec<Shape> = b
+        let shapes: Vec<(Shape, f32)> = b
             .shapes
             .iter()
-            .filter_map(|s| {
-                self.shapes
-                    .get(s.index, s.generation)
-                    .map(|r| (r.geometry, r.material.density))
-            })
-            .map(|(g, _)| g)
-            .collect();
-        let densities: Vec<f32> = b
-            .shapes
-            .iter()
-            .filter_map(|s| self.shapes.get(s.index, s.generation).map(|r| r.material.density))
+            .filter_map(|s| self.shapes.get(s.index, s.generation))
+            .map(|r| (r.geometry, r.material.density))
             .collect();
         let Some(b) = self.bodies.at_mut(body_index) else {
             return;
@@ -638,8 +629,8 @@ impl World {
         let old_center = b.center;
         let (mut mass, mut moment, mut weighted) = (0.0f32, 0.0f32, Vec2::ZERO);
         if b.body_type == BodyType::Dynamic {
-            for (g, &rho) in shapes.iter().zip(&densities) {
-                let md = g.mass(rho);
+            for (g, rho) in &shapes {
+                let md = g.mass(*rho);
                 mass += md.mass;
                 weighted += md.mass * md.center;
                 // inertia about the body origin: I_c + m |c|²
@@ -681,7 +672,7 @@ impl World {
         // Velocity of the new centre of mass: v + ω × (c_new − c_old).
         b.v += Vec2::cross_sv(b.w, b.center - old_center);
         let lc = b.local_center;
-        b.max_extent = shapes.iter().map(|g| g.max_extent(lc)).fold(0.0, f32::max);
+        b.max_extent = shapes.iter().map(|(g, _)| g.max_extent(lc)).fold(0.0, f32::max);
     }
 
     /// Re-mixes the materials of every contact of a body.
@@ -890,11 +881,8 @@ fn validate_geometry(g: &Shape) -> Result<()> {
                 return Err(Error::arg("Segment", "point1 and point2 coincide"));
             }
         }
-        Shape::Polygon(p) => {
-            // Polygons can only be built through validated constructors.
-            let _ = p;
-        }
+        // Polygons can only be built through validated constructors (private fields).
+        Shape::Polygon(_) => {}
     }
-    let _ = Rot::IDENTITY;
     Ok(())
 }
