@@ -425,6 +425,24 @@ pub fn tumbler() -> SceneFile {
     s
 }
 
+/// Box2D v3's pyramid of unit boxes (SCENES.md §2): `base` boxes in the bottom row; box
+/// (i, j), j = i…base−1, at x = 0.5 (i + 1) + (j − i) + `x_offset`, y = i + 0.5 + `base_y`.
+fn box2d_pyramid(s: &mut SceneFile, base: usize, x_offset: f32, base_y: f32) {
+    for i in 0..base {
+        for j in i..base {
+            let x = 0.5 * (i + 1) as f32 + (j - i) as f32 + x_offset;
+            let y = i as f32 + 0.5 + base_y;
+            s.bodies.push(body(
+                None,
+                BodyKind::Dynamic,
+                [x, y],
+                0.0,
+                vec![box_shape(0.5, 0.5, None)],
+            ));
+        }
+    }
+}
+
 /// Box2D v3's large_pyramid benchmark scene.
 pub fn large_pyramid() -> SceneFile {
     let mut s = scene("Box2D v3 benchmark large_pyramid", 500);
@@ -437,20 +455,7 @@ pub fn large_pyramid() -> SceneFile {
         0.0,
         vec![box_shape(100.0, 1.0, None)],
     ));
-    let base = 100;
-    for i in 0..base {
-        for j in i..base {
-            let x = 0.5 * (i + 1) as f32 + (j - i) as f32 - 50.0;
-            let y = i as f32 + 0.5;
-            s.bodies.push(body(
-                None,
-                BodyKind::Dynamic,
-                [x, y],
-                0.0,
-                vec![box_shape(0.5, 0.5, None)],
-            ));
-        }
-    }
+    box2d_pyramid(&mut s, 100, -50.0, 0.0);
     s
 }
 
@@ -474,19 +479,7 @@ pub fn many_pyramids() -> SceneFile {
         for c in 0..20 {
             let center_x = -110.0 + 11.0 * c as f32 + 1.0;
             let base_y = 11.0 * r as f32;
-            for i in 0..10 {
-                for j in i..10 {
-                    let x = 0.5 * (i + 1) as f32 + (j - i) as f32 + center_x - 0.5;
-                    let y = i as f32 + 0.5 + base_y;
-                    s.bodies.push(body(
-                        None,
-                        BodyKind::Dynamic,
-                        [x, y],
-                        0.0,
-                        vec![box_shape(0.5, 0.5, None)],
-                    ));
-                }
-            }
+            box2d_pyramid(&mut s, 10, center_x - 0.5, base_y);
         }
     }
     s

@@ -715,10 +715,10 @@ impl World {
     /// Updates the fat boxes of a body's shapes after its pose changed.
     /// `dt` > 0 also sweeps the boxes along the body's velocity for the next step.
     pub(crate) fn refresh_body_proxies(&mut self, body_index: u32, dt: f32) {
+        // Disjoint field borrows: no copy of the shape list in this per-step path.
         let Some(b) = self.bodies.at(body_index) else { return };
         let (xf, v) = (b.xf, b.v);
-        let shapes = b.shapes.clone();
-        for sid in shapes {
+        for &sid in &b.shapes {
             let Some(s) = self.shapes.get_mut(sid.index, sid.generation) else {
                 continue;
             };
