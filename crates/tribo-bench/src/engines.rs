@@ -42,6 +42,38 @@ impl EngineKind {
 }
 
 /// A built world that the harness can step and read.
+/// Per-stage profile sums over the sampled steps.
+#[derive(Default)]
+struct ProfileSum {
+    sums: Vec<(&'static str, f64)>,
+    steps: usize,
+}
+
+impl ProfileSum {
+    fn add(&mut self, fields: &[(&'static str, f32)]) {
+        if self.sums.is_empty() {
+            self.sums = fields.iter().map(|&(n, _)| (n, 0.0)).collect();
+        }
+        for (sum, &(_, x)) in self.sums.iter_mut().zip(fields) {
+            sum.1 += x as f64;
+        }
+        self.steps += 1;
+    }
+
+    fn report(&self, source: &str) -> String {
+        if self.steps == 0 {
+            return "no steps sampled".into();
+        }
+        let n = self.steps as f64;
+        self.sums
+            .iter()
+            .map(|(name, sum)| format!("{name} {:.3}", sum / n))
+            .collect::<Vec<_>>()
+            .join(", ")
+            + &format!(" (ms/step, {source})")
+    }
+}
+
 pub trait Sim {
     /// One step of the scene's dt with the scene's substeps.
     fn step(&mut self) -> Result<(), BoxError>;
@@ -89,6 +121,7 @@ mod tribo_sim {
         world: World,
         bodies: Vec<BodyId>,
         dt: f32,
+        profile: ProfileSum,
     }
 
     impl TriboSim {
@@ -109,6 +142,7 @@ mod tribo_sim {
                 world: built.world,
                 bodies: built.bodies,
                 dt: built.dt,
+                profile: ProfileSum::default(),
             })
         }
     }
@@ -155,8 +189,27 @@ mod tribo_sim {
                 })
                 .count()
         }
+        fn profile_sample(&mut self) {
+            let p = self.world.profile();
+            self.profile.add(&[
+                ("step", p.step),
+                ("pairs", p.pairs),
+                ("collide", p.collide),
+                ("solver_setup", p.solver_setup),
+                ("prepare", p.prepare),
+                ("integrate_velocities", p.integrate_velocities),
+                ("warm_start", p.warm_start),
+                ("solve", p.solve),
+                ("integrate_positions", p.integrate_positions),
+                ("relax", p.relax),
+                ("restitution", p.restitution),
+                ("store", p.store),
+                ("finalize", p.finalize),
+                ("sleep", p.sleep),
+            ]);
+        }
         fn profile_report(&self) -> String {
-            "not yet available (Tribo has no per-stage profile yet)".into()
+            self.profile.report("Tribo's World::profile")
         }
     }
 }
@@ -177,8 +230,7 @@ mod box2d_sim {
         dt: f32,
         substeps: i32,
         threads: usize,
-        profile_sum: Vec<(&'static str, f64)>,
-        profile_steps: usize,
+        profile: ProfileSum,
     }
 
     fn v(a: [f32; 2]) -> Vec2 {
@@ -277,8 +329,7 @@ mod box2d_sim {
                 dt: scene.dt,
                 substeps: scene.substeps as i32,
                 threads,
-                profile_sum: Vec::new(),
-                profile_steps: 0,
+                profile: ProfileSum::default(),
             })
         }
     }
@@ -343,27 +394,11 @@ mod box2d_sim {
         }
         fn profile_sample(&mut self) {
             if let Ok(p) = self.world.profile() {
-                let fields = profile_fields(&p);
-                if self.profile_sum.is_empty() {
-                    self.profile_sum = fields.iter().map(|&(n, _)| (n, 0.0)).collect();
-                }
-                for (sum, (_, x)) in self.profile_sum.iter_mut().zip(fields) {
-                    sum.1 += x as f64;
-                }
-                self.profile_steps += 1;
+                self.profile.add(&profile_fields(&p));
             }
         }
         fn profile_report(&self) -> String {
-            if self.profile_steps == 0 {
-                return "no steps sampled".into();
-            }
-            let n = self.profile_steps as f64;
-            self.profile_sum
-                .iter()
-                .map(|(name, sum)| format!("{name} {:.3}", sum / n))
-                .collect::<Vec<_>>()
-                .join(", ")
-                + " (ms/step, Box2D's b2Profile)"
+            self.profile.report("Box2D's b2Profile")
         }
     }
 }

@@ -59,6 +59,6 @@ pub use error::{Error, Result};
 pub use geometry::{Capsule, Circle, GeometryError, MassData, Polygon, Segment, Shape};
 pub use math::{Aabb, Rot, Transform, Vec2};
 pub use world::{
-    BodyId, ContactBeginEvent, ContactEndEvent, ContactEvents, ContactInfo, ContactPointInfo, QueryFilter, RayResult,
-    ShapeId, World, WorldDef,
+    BodyId, ContactBeginEvent, ContactEndEvent, ContactEvents, ContactInfo, ContactPointInfo, Profile, QueryFilter,
+    RayResult, ShapeId, World, WorldDef,
 };

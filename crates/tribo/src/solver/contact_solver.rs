@@ -52,6 +52,8 @@
 //! The two normal rows of a 2-point manifold are solved together (a 2×2 LCP, Box2D v2.4's
 //! block solver in soft form), so one iteration is exact within the manifold.
 
+use super::contact_wide::{self, Slot, WideContact, COLORS};
+use super::wide::LANES;
 use super::{BodyState, ConstraintSet, Softness, StepContext};
 use crate::collision::contact::{Contact, FrictionState};
 use crate::math::Vec2;
@@ -147,6 +149,21 @@ pub(crate) struct ContactSolver {
     /// constraints of one light body that carries a much heavier one.
     groups: Vec<(u32, u32, u32)>,
     group_members: Vec<u32>,
+    /// The coloured constraints, four per wide constraint, colour after colour.
+    wide: Vec<WideContact>,
+    /// `wide[colour_ranges[k].0 .. colour_ranges[k].1]` is colour k (non-empty colours).
+    colour_ranges: Vec<(u32, u32)>,
+    /// Constraints that found no colour (solved by the scalar code first in each pass).
+    overflow: Vec<u32>,
+    /// Where each constraint of `constraints` lives during the substeps.
+    slots: Vec<Slot>,
+    colours: Vec<Option<u8>>,
+}
+
+/// Whether a constraint side is a dynamic body (moves under impulses).
+#[inline]
+fn dynamic_side(inv_mass: f32, inv_i: f32) -> bool {
+    inv_mass > 0.0 || inv_i > 0.0
 }
 
 impl ContactSolver {
@@ -282,6 +299,201 @@ impl ContactSolver {
                 }
             }
             self.groups.push((start, self.group_members.len() as u32, sweeps));
+        }
+    }
+
+    /// Colours the constraints and packs them into wide constraints (after the estimate,
+    /// before the substeps).
+    fn pack(&mut self, body_count: usize) {
+        let mut dynamic = vec![false; body_count];
+        for cc in &self.constraints {
+            dynamic[cc.index_a as usize] |= dynamic_side(cc.inv_mass_a, cc.inv_i_a);
+            dynamic[cc.index_b as usize] |= dynamic_side(cc.inv_mass_b, cc.inv_i_b);
+        }
+        dynamic[0] = false;
+        contact_wide::color_constraints(
+            &self.constraints,
+            |i| dynamic[i as usize],
+            body_count,
+            &mut self.colours,
+        );
+        let mut by_colour: [Vec<u32>; COLORS] = Default::default();
+        self.overflow.clear();
+        for (i, colour) in self.colours.iter().enumerate() {
+            match colour {
+                Some(k) => by_colour[*k as usize].push(i as u32),
+                None => self.overflow.push(i as u32),
+            }
+        }
+        self.wide.clear();
+        self.colour_ranges.clear();
+        self.slots.clear();
+        self.slots.resize(self.constraints.len(), Slot::Overflow);
+        for members in by_colour.iter().filter(|m| !m.is_empty()) {
+            let start = self.wide.len() as u32;
+            for chunk in members.chunks(LANES) {
+                let mut w = WideContact::default();
+                for (l, &ci) in chunk.iter().enumerate() {
+                    let cc = &self.constraints[ci as usize];
+                    let (da, db) = (dynamic[cc.index_a as usize], dynamic[cc.index_b as usize]);
+                    contact_wide::pack(&mut w, l, cc, da, db);
+                    self.slots[ci as usize] = Slot::Wide {
+                        group: self.wide.len() as u32,
+                        lane: l as u8,
+                    };
+                }
+                self.wide.push(w);
+            }
+            self.colour_ranges.push((start, self.wide.len() as u32));
+        }
+    }
+
+    /// Copies the wide constraints' impulses back into `constraints`.
+    fn unpack(&mut self) {
+        for (cc, slot) in self.constraints.iter_mut().zip(&self.slots) {
+            if let Slot::Wide { group, lane } = *slot {
+                contact_wide::unpack_state(&self.wide[group as usize], lane as usize, cc);
+            }
+        }
+    }
+
+    /// One scalar pass over constraint `ci` wherever it lives.
+    fn solve_scalar(&mut self, ci: usize, states: &mut [BodyState], ctx: &StepContext, use_bias: bool, elapsed: f32) {
+        let cc = &mut self.constraints[ci];
+        match self.slots[ci] {
+            Slot::Wide { group, lane } => {
+                let w = &mut self.wide[group as usize];
+                contact_wide::unpack_state(w, lane as usize, cc);
+                solve_one(cc, states, ctx, use_bias, elapsed);
+                contact_wide::pack_state(w, lane as usize, cc);
+            }
+            Slot::Overflow => solve_one(cc, states, ctx, use_bias, elapsed),
+        }
+    }
+
+    /// First guess of the estimate: the loads of a rigid structure at rest, passed from the
+    /// top down (`subset` sorted by height, highest first). Each body that rests on
+    /// supports below it (contacts whose normal is within 60° of "up") carries its own
+    /// weight plus what the bodies above put on it; the total is shared between its
+    /// outermost supports by the lever rule (the two reactions whose moments about the
+    /// load's line of action balance: `w_hi = W (c − x_lo) / (x_hi − x_lo)`), evenly between
+    /// the points of one manifold, and passed on to the supporting bodies. This is exact
+    /// for stacks and pyramids (statically determinate per body) and a good start for piles;
+    /// the rigid sweeps that follow correct it. Sequential sweeps alone need on the order of
+    /// N² sweeps to carry the weight of an N-high stack to the ground.
+    fn statics_estimate(&mut self, subset: &[usize], trial: &mut [BodyState]) {
+        let up = self.up;
+        if up == Vec2::ZERO {
+            return;
+        }
+        let lat = up.right_perp();
+        let n_states = trial.len();
+        // Supports of each upper body, in subset order: (upper state, constraint, upper is B).
+        let mut supports: Vec<(u32, usize, bool)> = Vec::new();
+        for &i in subset {
+            let cc = &self.constraints[i];
+            let up_n = cc.normal.dot(up);
+            let (upper, upper_is_b, inv_m) = if up_n > 0.5 {
+                (cc.index_b, true, cc.inv_mass_b)
+            } else if up_n < -0.5 {
+                (cc.index_a, false, cc.inv_mass_a)
+            } else {
+                continue;
+            };
+            if upper != 0 && inv_m > 0.0 {
+                supports.push((upper, i, upper_is_b));
+            }
+        }
+        if supports.is_empty() {
+            return;
+        }
+        // Order of first appearance (highest support first) for each upper body.
+        let mut first = vec![u32::MAX; n_states];
+        for (k, s) in supports.iter().enumerate() {
+            let f = &mut first[s.0 as usize];
+            *f = (*f).min(k as u32);
+        }
+        supports.sort_by_key(|s| (first[s.0 as usize], s.1));
+        let mut load = vec![0.0f32; n_states];
+        let mut moment = vec![0.0f32; n_states];
+        let mut start = 0;
+        while start < supports.len() {
+            let upper = supports[start].0;
+            let mut end = start;
+            while end < supports.len() && supports[end].0 == upper {
+                end += 1;
+            }
+            let group = &supports[start..end];
+            start = end;
+            let (i0, b0) = (group[0].1, group[0].2);
+            let inv_m = if b0 {
+                self.constraints[i0].inv_mass_b
+            } else {
+                self.constraints[i0].inv_mass_a
+            };
+            // Own weight: the impulse that stops this substep's fall, acting at the centre.
+            let fall = (-trial[upper as usize].v.dot(up)).max(0.0);
+            let own = fall / inv_m;
+            let w_total = own + load[upper as usize];
+            if w_total <= 0.0 {
+                continue;
+            }
+            let c = moment[upper as usize] / w_total;
+            // Lateral position of each support (mean of its points) from the upper centre.
+            let x_of = |cc: &ContactConstraint, upper_is_b: bool| {
+                let sum: f32 = cc.points[..cc.count]
+                    .iter()
+                    .map(|p| if upper_is_b { p.r_b } else { p.r_a }.dot(lat))
+                    .sum();
+                sum / cc.count as f32
+            };
+            let (mut lo, mut hi) = (0usize, 0usize);
+            let xs: Vec<f32> = group.iter().map(|s| x_of(&self.constraints[s.1], s.2)).collect();
+            for k in 0..xs.len() {
+                if xs[k] < xs[lo] {
+                    lo = k;
+                }
+                if xs[k] > xs[hi] {
+                    hi = k;
+                }
+            }
+            let mut shares = vec![0.0f32; group.len()];
+            if xs[hi] - xs[lo] < 1e-6 {
+                shares.iter_mut().for_each(|s| *s = w_total / group.len() as f32);
+            } else {
+                let w_hi = (w_total * (c - xs[lo]) / (xs[hi] - xs[lo])).clamp(0.0, w_total);
+                shares[hi] = w_hi;
+                shares[lo] = w_total - w_hi;
+            }
+            for (k, &(_, ci, upper_is_b)) in group.iter().enumerate() {
+                let w = shares[k];
+                let cc = &mut self.constraints[ci];
+                let up_n = cc.normal.dot(up).abs();
+                let count = cc.count;
+                for cp in &mut cc.points[..count] {
+                    cp.normal_impulse = w / (count as f32 * up_n);
+                }
+                let lower = if upper_is_b { cc.index_a } else { cc.index_b };
+                if lower != 0 {
+                    // The reaction's lateral position seen from the lower body's centre.
+                    let x_lower: f32 = cc.points[..count]
+                        .iter()
+                        .map(|p| if upper_is_b { p.r_a } else { p.r_b }.dot(lat))
+                        .sum::<f32>()
+                        / count as f32;
+                    load[lower as usize] += w;
+                    moment[lower as usize] += w * x_lower;
+                }
+            }
+        }
+        // The trial velocities must carry the impulses the sweeps start from.
+        for &(_, ci, _) in &supports {
+            let cc = &self.constraints[ci];
+            let (mut a, mut b) = load_states(trial, cc.index_a, cc.index_b);
+            for cp in &cc.points[..cc.count] {
+                apply(cc, &mut a, &mut b, cp.r_a, cp.r_b, cp.normal_impulse * cc.normal);
+            }
+            store(trial, cc.index_a, cc.index_b, a, b);
         }
     }
 
@@ -535,6 +747,11 @@ fn anchor_displacement(a: &BodyState, b: &BodyState, r_a: Vec2, r_b: Vec2) -> Ve
 
 /// Reads two body states; index 0 is the shared static body, never written.
 #[inline]
+fn load_states(states: &[BodyState], ia: u32, ib: u32) -> (BodyState, BodyState) {
+    load(states, ia, ib)
+}
+
+#[inline]
 fn load(states: &[BodyState], ia: u32, ib: u32) -> (BodyState, BodyState) {
     (states[ia as usize], states[ib as usize])
 }
@@ -558,31 +775,24 @@ impl ConstraintSet for ContactSolver {
     }
 
     fn warm_start(&mut self, states: &mut [BodyState]) {
-        for cc in &mut self.constraints {
-            let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
-            let n = cc.normal;
-            let t = n.right_perp();
-            if cc.restitution > 0.0 {
-                // Impact speed for restitution: the approach velocity before this
-                // substep's impulses, whichever pass then catches the impact.
-                for i in 0..cc.count {
-                    let (r_a, r_b) = (cc.points[i].r_a, cc.points[i].r_b);
-                    cc.points[i].substep_vn = point_velocity(cc, &a, &b, r_a, r_b).dot(n);
-                }
-            }
-            for cp in &cc.points[..cc.count] {
-                let p = cp.normal_impulse * n + cp.tangent_impulse * t;
-                apply(cc, &mut a, &mut b, cp.r_a, cp.r_b, p);
-            }
-            a.w -= cc.inv_i_a * cc.rolling_impulse;
-            b.w += cc.inv_i_b * cc.rolling_impulse;
-            store(states, cc.index_a, cc.index_b, a, b);
+        for &ci in &self.overflow {
+            warm_start_one(&mut self.constraints[ci as usize], states);
+        }
+        for w in &mut self.wide {
+            contact_wide::warm_start(w, states);
         }
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, elapsed: f32) {
-        for cc in &mut self.constraints {
-            solve_one(cc, states, ctx, use_bias, elapsed);
+        for &ci in &self.overflow {
+            solve_one(&mut self.constraints[ci as usize], states, ctx, use_bias, elapsed);
+        }
+        for w in &mut self.wide {
+            if use_bias {
+                contact_wide::solve::<true>(w, states, ctx, elapsed);
+            } else {
+                contact_wide::solve::<false>(w, states, ctx, elapsed);
+            }
         }
         // Extra local sweeps where a light body carries a heavy one, in the relax pass only:
         // the soft rows of the biased pass are formulated for exactly one sweep (each
@@ -590,10 +800,12 @@ impl ConstraintSet for ContactSolver {
         if use_bias {
             return;
         }
-        for &(start, end, sweeps) in &self.groups {
+        for g in 0..self.groups.len() {
+            let (start, end, sweeps) = self.groups[g];
             for _ in 0..sweeps {
-                for &ci in &self.group_members[start as usize..end as usize] {
-                    solve_one(&mut self.constraints[ci as usize], states, ctx, use_bias, elapsed);
+                for m in start..end {
+                    let ci = self.group_members[m as usize] as usize;
+                    self.solve_scalar(ci, states, ctx, use_bias, elapsed);
                 }
             }
         }
@@ -637,6 +849,7 @@ impl ConstraintSet for ContactSolver {
         // Bound the work (the first step of a large scene pays it): at most
         // ESTIMATE_BUDGET row solves, between 16 and MAX_ESTIMATE_SWEEPS sweeps.
         let sweeps = (ESTIMATE_BUDGET / subset.len()).clamp(16, MAX_ESTIMATE_SWEEPS);
+        self.statics_estimate(&subset, trial);
         for _ in 0..sweeps {
             let (mut change, mut largest) = (0.0f32, 0.0f32);
             for &i in &subset {
@@ -665,15 +878,24 @@ impl ConstraintSet for ContactSolver {
     }
 
     fn end_substep(&mut self) {
-        for cc in &mut self.constraints {
+        for &ci in &self.overflow {
+            let cc = &mut self.constraints[ci as usize];
             for cp in &mut cc.points[..cc.count] {
                 cp.total_normal_impulse += cp.normal_impulse;
                 cp.total_tangent_impulse += cp.tangent_impulse;
             }
         }
+        for w in &mut self.wide {
+            contact_wide::end_substep(w);
+        }
+    }
+
+    fn begin_substeps(&mut self, body_count: usize) {
+        self.pack(body_count);
     }
 
     fn restitution(&mut self, states: &mut [BodyState]) {
+        self.unpack();
         for cc in &mut self.constraints {
             if cc.restitution == 0.0 {
                 continue;
@@ -749,6 +971,25 @@ impl ConstraintSet for ContactSolver {
             store(states, cc.index_a, cc.index_b, a, b);
         }
     }
+}
+
+/// Re-applies one constraint's accumulated impulses at the start of a substep, after
+/// recording its points' normal velocities (restitution's impact speed).
+fn warm_start_one(cc: &mut ContactConstraint, states: &mut [BodyState]) {
+    let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
+    let n = cc.normal;
+    let t = n.right_perp();
+    for i in 0..cc.count {
+        let (r_a, r_b) = (cc.points[i].r_a, cc.points[i].r_b);
+        cc.points[i].substep_vn = point_velocity(cc, &a, &b, r_a, r_b).dot(n);
+    }
+    for cp in &cc.points[..cc.count] {
+        let p = cp.normal_impulse * n + cp.tangent_impulse * t;
+        apply(cc, &mut a, &mut b, cp.r_a, cp.r_b, p);
+    }
+    a.w -= cc.inv_i_a * cc.rolling_impulse;
+    b.w += cc.inv_i_b * cc.rolling_impulse;
+    store(states, cc.index_a, cc.index_b, a, b);
 }
 
 /// One pass over one contact: normal rows, friction rows, rolling resistance.

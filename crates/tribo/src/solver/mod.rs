@@ -17,9 +17,12 @@
 //! joints will be another.
 
 pub(crate) mod contact_solver;
+pub(crate) mod contact_wide;
 pub(crate) mod softness;
+pub(crate) mod wide;
 
 use crate::math::{Rot, Vec2};
+use crate::world::{Profile, Stopwatch};
 pub(crate) use softness::Softness;
 
 /// Velocity and accumulated motion of one awake body during a step (32 bytes, hot).
@@ -82,6 +85,9 @@ pub(crate) trait ConstraintSet {
     fn warm_start(&mut self, states: &mut [BodyState]);
     /// One sequential-impulse pass; `use_bias` adds the soft position correction.
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, elapsed: f32);
+    /// Arranges the constraints for the substeps (colouring, wide packing) once the
+    /// warm-start impulses are final; `body_count` is the number of solver states.
+    fn begin_substeps(&mut self, body_count: usize);
     /// Accumulates what a substep applied (after its relax pass).
     fn end_substep(&mut self);
     /// Estimates warm-start impulses for constraints that begin at rest (no history):
@@ -92,13 +98,16 @@ pub(crate) trait ConstraintSet {
     fn restitution(&mut self, states: &mut [BodyState]);
 }
 
-/// Runs the stages of one step over the awake bodies and a constraint set.
+/// Runs the stages of one step over the awake bodies and a constraint set, timing each
+/// stage into `profile`.
 pub(crate) fn solve_step<C: ConstraintSet>(
     ctx: &StepContext,
     sims: &[BodySim],
     states: &mut [BodyState],
     constraints: &mut C,
+    profile: &mut Profile,
 ) {
+    let mut lap = Stopwatch::start();
     constraints.prepare(ctx, states);
     // A contact that begins at rest has no warm start: its first substeps would let the
     // body sag and slide before the load builds up (the settling creep of Box2D and
@@ -109,18 +118,34 @@ pub(crate) fn solve_step<C: ConstraintSet>(
         constraints.record_approach(&trial);
         constraints.estimate_new_contacts(ctx, &mut trial);
     }
+    constraints.begin_substeps(states.len());
+    profile.prepare = lap.lap();
+    let mut t = [0.0f32; 5];
     for i in 0..ctx.substeps {
         integrate_velocities(ctx, sims, states);
+        t[0] += lap.lap();
         // Always called: it also records approach speeds (impulses are zero when warm
         // starting is off).
         constraints.warm_start(states);
+        t[1] += lap.lap();
         let elapsed = i as f32 * ctx.h;
         constraints.solve(ctx, states, true, elapsed);
+        t[2] += lap.lap();
         integrate_positions(ctx, sims, states);
+        t[3] += lap.lap();
         constraints.solve(ctx, states, false, elapsed + ctx.h);
         constraints.end_substep();
+        t[4] += lap.lap();
     }
+    [
+        profile.integrate_velocities,
+        profile.warm_start,
+        profile.solve,
+        profile.integrate_positions,
+        profile.relax,
+    ] = t;
     constraints.restitution(states);
+    profile.restitution = lap.lap();
 }
 
 /// v ← (v + h·a) / (1 + h·c): explicit forces, Padé damping (Box2D v3).

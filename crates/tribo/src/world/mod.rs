@@ -6,11 +6,14 @@
 
 mod events;
 mod ids;
+mod profile;
 mod query;
 mod step;
 
 pub use events::{ContactBeginEvent, ContactEndEvent, ContactEvents, ContactInfo, ContactPointInfo};
 pub use ids::{BodyId, ShapeId};
+pub use profile::Profile;
+pub(crate) use profile::Stopwatch;
 pub use query::{QueryFilter, RayResult};
 
 pub(crate) use ids::Arena;
@@ -111,6 +114,7 @@ pub struct World {
     pub(crate) scratch_u32: Vec<u32>,
     pub(crate) scratch_f32: Vec<f32>,
     pub(crate) step_count: u64,
+    pub(crate) profile: Profile,
 }
 
 impl World {
@@ -134,7 +138,13 @@ impl World {
             scratch_u32: Vec::new(),
             scratch_f32: Vec::new(),
             step_count: 0,
+            profile: Profile::default(),
         })
+    }
+
+    /// Per-stage wall-clock times of the last step.
+    pub fn profile(&self) -> Profile {
+        self.profile
     }
 
     /// The settings in force.

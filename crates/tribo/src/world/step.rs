@@ -6,7 +6,7 @@
 //! 4. [`World::finalize`]: poses from the solver, swept fat boxes, sleep timers.
 //! 5. [`World::update_sleep`]: islands that rested long enough fall asleep.
 
-use super::{ContactBeginEvent, ContactEndEvent, World};
+use super::{ContactBeginEvent, ContactEndEvent, Stopwatch, World};
 use crate::collision::broad_phase::{MOVING_TREE, STATIC_TREE};
 use crate::collision::contact::{pair_key, Contact, PointState};
 use crate::dynamics::{mix, BodyType};
@@ -31,12 +31,20 @@ impl World {
         if dt == 0.0 {
             return Ok(());
         }
+        let mut total = Stopwatch::start();
+        let mut lap = Stopwatch::start();
         self.update_pairs();
+        self.profile.pairs = lap.lap();
         self.collide(dt);
+        self.profile.collide = lap.lap();
         let ctx = self.step_context(dt);
         self.solve(&ctx);
+        lap.lap();
         self.finalize(dt);
+        self.profile.finalize = lap.lap();
         self.update_sleep(dt);
+        self.profile.sleep = lap.lap();
+        self.profile.step = total.lap();
         self.step_count += 1;
         Ok(())
     }
@@ -233,6 +241,7 @@ impl World {
     /// Builds the solver arrays from the awake bodies and touching contacts, runs the
     /// solver stages and stores impulses back into the contacts.
     fn solve(&mut self, ctx: &StepContext) {
+        let mut lap = Stopwatch::start();
         let g = self.def.gravity;
         self.states.clear();
         self.sims.clear();
@@ -303,13 +312,16 @@ impl World {
                 solver.push(ci as u32, c, &bodies);
             }
         }
-        solve_step(ctx, &self.sims, &mut self.states, &mut solver);
+        self.profile.solver_setup = lap.lap();
+        solve_step(ctx, &self.sims, &mut self.states, &mut solver, &mut self.profile);
+        lap.lap();
         for cc in &solver.constraints {
             if let Some(Some(c)) = self.contacts.get_mut(cc.contact as usize) {
                 store_impulses(cc, c, &self.states, ctx);
             }
         }
         self.contact_solver = solver;
+        self.profile.store = lap.lap();
     }
 
     /// Writes the solver's motion back to the bodies, refreshes fat boxes and sleep timers.

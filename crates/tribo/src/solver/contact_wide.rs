@@ -1,0 +1,509 @@
+//! The wide contact solver: graph colouring and four contacts per SIMD lane group.
+//!
+//! The physics is exactly the scalar contact constraint's ([`super::contact_solver`]: soft
+//! normal rows with preload, 2×2 block solve, patch friction with stick/slip and the drift
+//! anchor, rolling resistance); this module only changes the order and the layout:
+//!
+//! * **Graph colouring** (Box2D v3's `constraint_graph.c`, greedy first fit): constraints in
+//!   one colour share no moving body, so their order inside the colour does not matter and
+//!   four of them can be solved at once. Constraints between two moving bodies take the
+//!   lowest free colour; constraints with a static or kinematic side take the highest free
+//!   colour, so each pass solves them last (the ground has the last word, as in Box2D).
+//!   A constraint that finds no colour goes to the overflow list, solved by the scalar code
+//!   before the coloured work of each pass.
+//! * **Wide layout**: [`WideContact`] holds four constraints as structure-of-arrays
+//!   ([`F4`] lanes). Every lane has two points; a one-point manifold has a second point
+//!   with zero mass, anchors and impulses, which then changes nothing. Friction is one
+//!   row per lane: the patch row at the middle of a two-point manifold, or the point row
+//!   of a one-point manifold (the same row with one point). Empty lanes of the last group
+//!   of a colour use the static body (index 0) on both sides and zero masses.
+//! * Body velocities are gathered from [`BodyState`] into lanes and scattered back; only
+//!   dynamic bodies are written (no two lanes of a colour share one).
+//!
+//! A lane computes the same expressions as the scalar code in the same order of
+//! operations, so a contact solved wide or scalar gets the same numbers.
+
+use super::contact_solver::ContactConstraint;
+use super::wide::{F4, LANES, M4, V4};
+use super::{BodyState, StepContext};
+use crate::math::Vec2;
+
+/// Number of colours (Box2D v3 uses 24, the last for overflow).
+pub(crate) const COLORS: usize = 24;
+/// Colours open to constraints between two moving bodies (the rest, counted from the top,
+/// are for constraints with a static or kinematic side).
+const DYNAMIC_COLORS: usize = 20;
+
+/// One point of four constraints.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct WidePoint {
+    pub r_a: V4,
+    pub r_b: V4,
+    pub base_separation: F4,
+    pub normal_mass: F4,
+    pub normal_impulse: F4,
+    pub preload: F4,
+    pub total_normal_impulse: F4,
+    pub max_normal_impulse: F4,
+    pub approach: F4,
+    pub substep_vn: F4,
+}
+
+/// Four contact constraints, one per lane (see the module docs).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct WideContact {
+    pub index_a: [u32; LANES],
+    pub index_b: [u32; LANES],
+    /// Whether the lane's body A (B) is dynamic, i.e. written back by the scatter.
+    pub write_a: [bool; LANES],
+    pub write_b: [bool; LANES],
+    pub normal: V4,
+    pub inv_mass_a: F4,
+    pub inv_i_a: F4,
+    pub inv_mass_b: F4,
+    pub inv_i_b: F4,
+    pub split: F4,
+    pub mu_s: F4,
+    pub mu_d: F4,
+    pub tangent_speed: F4,
+    pub rolling_resistance: F4,
+    pub rolling_mass: F4,
+    pub rolling_impulse: F4,
+    pub bias_rate: F4,
+    pub mass_scale: F4,
+    pub impulse_scale: F4,
+    pub points: [WidePoint; 2],
+    /// Normal-row matrix K and its inverse (2-point manifolds with `block`).
+    pub k11: F4,
+    pub k12: F4,
+    pub k22: F4,
+    pub i11: F4,
+    pub i12: F4,
+    pub i22: F4,
+    /// 1/k11 and 1/k22 (0 where the block solve does not apply).
+    pub inv_k11: F4,
+    pub inv_k22: F4,
+    pub block: M4,
+    /// Friction row anchors (patch middle or the single point).
+    pub friction_r_a: V4,
+    pub friction_r_b: V4,
+    pub tangent_mass: F4,
+    pub base_drift: F4,
+    pub stick: M4,
+    /// Friction impulse of the row (sum over the points) [N·s].
+    pub tangent_impulse: F4,
+    pub total_tangent_impulse: F4,
+    pub saturated: M4,
+    /// Share of the row's friction impulse each point reports (½, ½ or 1, 0).
+    pub tangent_share: [F4; 2],
+    pub any_rolling: bool,
+}
+
+/// Four bodies' velocities and step motion, gathered from [`BodyState`]s.
+#[derive(Clone, Copy, Debug)]
+struct WideBody {
+    v: V4,
+    w: F4,
+    touched: F4,
+    dp: V4,
+    /// sin of the rotation since the step start.
+    dq_s: F4,
+}
+
+#[inline(always)]
+fn gather(states: &[BodyState], idx: &[u32; LANES]) -> WideBody {
+    let mut b = WideBody {
+        v: V4::default(),
+        w: F4::ZERO,
+        touched: F4::ZERO,
+        dp: V4::default(),
+        dq_s: F4::ZERO,
+    };
+    for l in 0..LANES {
+        let s = &states[idx[l] as usize];
+        b.v.x.0[l] = s.v.x;
+        b.v.y.0[l] = s.v.y;
+        b.w.0[l] = s.w;
+        b.touched.0[l] = s.touched;
+        b.dp.x.0[l] = s.dp.x;
+        b.dp.y.0[l] = s.dp.y;
+        b.dq_s.0[l] = s.dq.s;
+    }
+    b
+}
+
+#[inline(always)]
+fn scatter(states: &mut [BodyState], idx: &[u32; LANES], write: &[bool; LANES], b: &WideBody) {
+    for l in 0..LANES {
+        if write[l] {
+            let s = &mut states[idx[l] as usize];
+            s.v = Vec2::new(b.v.x.0[l], b.v.y.0[l]);
+            s.w = b.w.0[l];
+            s.touched = b.touched.0[l];
+        }
+    }
+}
+
+/// Lever arms of a pass (the anchors moved to their common point, see
+/// `contact_solver::lever_arms`).
+#[inline(always)]
+fn lever_arms(c: &WideContact, d: V4, r_a: V4, r_b: V4) -> (V4, V4) {
+    let one = F4::splat(1.0);
+    (r_a + d.scale(c.split), r_b - d.scale(one - c.split))
+}
+
+#[inline(always)]
+fn relative_velocity(a: &WideBody, b: &WideBody, r_a: V4, r_b: V4) -> V4 {
+    let vb = V4 {
+        x: b.v.x - b.w * r_b.y,
+        y: b.v.y + b.w * r_b.x,
+    };
+    let va = V4 {
+        x: a.v.x - a.w * r_a.y,
+        y: a.v.y + a.w * r_a.x,
+    };
+    vb - va
+}
+
+#[inline(always)]
+fn apply(c: &WideContact, a: &mut WideBody, b: &mut WideBody, r_a: V4, r_b: V4, p: V4) {
+    a.v = a.v - p.scale(c.inv_mass_a);
+    a.w -= c.inv_i_a * r_a.cross(p);
+    b.v = b.v + p.scale(c.inv_mass_b);
+    b.w += c.inv_i_b * r_b.cross(p);
+}
+
+/// First-order relative displacement of the material points (see
+/// `contact_solver::anchor_displacement`).
+#[inline(always)]
+fn anchor_displacement(a: &WideBody, b: &WideBody, d: V4, r_a: V4, r_b: V4) -> V4 {
+    d + (r_b.left_perp().scale(b.dq_s) - r_a.left_perp().scale(a.dq_s))
+}
+
+/// Re-applies the accumulated impulses at the start of a substep and records each point's
+/// normal velocity before them (restitution's impact speed).
+pub(crate) fn warm_start(c: &mut WideContact, states: &mut [BodyState]) {
+    let mut a = gather(states, &c.index_a);
+    let mut b = gather(states, &c.index_b);
+    let d = b.dp - a.dp;
+    let n = c.normal;
+    let t = V4 { x: n.y, y: -n.x };
+    let mut arms = [(V4::default(), V4::default()); 2];
+    for (i, arm) in arms.iter_mut().enumerate() {
+        let p = &c.points[i];
+        *arm = lever_arms(c, d, p.r_a, p.r_b);
+        c.points[i].substep_vn = relative_velocity(&a, &b, arm.0, arm.1).dot(n);
+    }
+    for (i, &(r_a, r_b)) in arms.iter().enumerate() {
+        let p = &c.points[i];
+        let lt = c.tangent_impulse * c.tangent_share[i];
+        let imp = n.scale(p.normal_impulse) + t.scale(lt);
+        apply(c, &mut a, &mut b, r_a, r_b, imp);
+    }
+    if c.any_rolling {
+        a.w -= c.inv_i_a * c.rolling_impulse;
+        b.w += c.inv_i_b * c.rolling_impulse;
+    }
+    scatter(states, &c.index_a, &c.write_a, &a);
+    scatter(states, &c.index_b, &c.write_b, &b);
+}
+
+/// One pass over four constraints: normal rows (block or sequential), the friction row,
+/// rolling resistance in the relax pass.
+pub(crate) fn solve<const USE_BIAS: bool>(
+    c: &mut WideContact,
+    states: &mut [BodyState],
+    ctx: &StepContext,
+    elapsed: f32,
+) {
+    let mut a = gather(states, &c.index_a);
+    let mut b = gather(states, &c.index_b);
+    let d = b.dp - a.dp;
+    let n = c.normal;
+    let zero = F4::ZERO;
+    let one = F4::splat(1.0);
+    let push = F4::splat(ctx.push_speed);
+
+    // Normal rows: bias and softness per point (contact_solver::normal_row).
+    let mut arms = [(V4::default(), V4::default()); 2];
+    let mut vn = [zero; 2];
+    let mut bias = [zero; 2];
+    let mut ms = [zero; 2];
+    let mut is = [zero; 2];
+    for i in 0..2 {
+        let p = &c.points[i];
+        arms[i] = lever_arms(c, d, p.r_a, p.r_b);
+        let s = anchor_displacement(&a, &b, d, p.r_a, p.r_b).dot(n) + p.base_separation;
+        let speculative = s.gt(zero);
+        let (soft_bias, soft_ms, soft_is) = if USE_BIAS {
+            ((c.bias_rate * s).max(-push), c.mass_scale, c.impulse_scale)
+        } else {
+            (zero, one, zero)
+        };
+        bias[i] = speculative.select(s * F4::splat(ctx.inv_h), soft_bias);
+        ms[i] = speculative.select(one, soft_ms);
+        is[i] = speculative.select(zero, soft_is);
+        vn[i] = relative_velocity(&a, &b, arms[i].0, arms[i].1).dot(n);
+    }
+    let [p0, p1] = &c.points;
+    let (lam0, lam1) = (p0.normal_impulse, p1.normal_impulse);
+    let (pre0, pre1) = (p0.preload, p1.preload);
+    // The 2×2 block LCP (contact_solver::solve_block), all four cases in every lane.
+    let rhs0 = vn[0] + bias[0];
+    let rhs1 = vn[1] + bias[1];
+    let soft0 = |rd: F4| lam0 + ms[0] * rd - is[0] * (lam0 - pre0);
+    let soft1 = |rd: F4| lam1 + ms[1] * rd - is[1] * (lam1 - pre1);
+    let xa0 = soft0(-(c.i11 * rhs0 + c.i12 * rhs1));
+    let xa1 = soft1(-(c.i12 * rhs0 + c.i22 * rhs1));
+    let ok_a = xa0.ge(zero) & xa1.ge(zero);
+    let r0 = rhs0 - c.k12 * lam1;
+    let xb0 = soft0(-(r0 * c.inv_k11));
+    let wb1 = rhs1 + c.k12 * (xb0 - lam0) - c.k22 * lam1;
+    let ok_b = xb0.ge(zero) & wb1.ge(zero);
+    let r1 = rhs1 - c.k12 * lam0;
+    let xc1 = soft1(-(r1 * c.inv_k22));
+    let wc0 = rhs0 + c.k12 * (xc1 - lam1) - c.k11 * lam0;
+    let ok_c = xc1.ge(zero) & wc0.ge(zero);
+    let wd0 = rhs0 - c.k11 * lam0 - c.k12 * lam1;
+    let wd1 = rhs1 - c.k12 * lam0 - c.k22 * lam1;
+    let ok_d = wd0.ge(zero) & wd1.ge(zero);
+    let block0 = ok_a.select(xa0, ok_b.select(xb0, zero));
+    let block1 = ok_a.select(xa1, (!ok_b & ok_c).select(xc1, zero));
+    let found = c.block & (ok_a | ok_b | ok_c | ok_d);
+    // Sequential rows where the block solve does not apply.
+    let seq0 = (lam0 + (-(p0.normal_mass * ms[0] * rhs0) - is[0] * (lam0 - pre0))).max(zero);
+    let new0 = found.select(block0, seq0);
+    apply(c, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(new0 - lam0));
+    let vn1 = relative_velocity(&a, &b, arms[1].0, arms[1].1).dot(n);
+    let seq1 = (lam1 + (-(p1.normal_mass * ms[1] * (vn1 + bias[1])) - is[1] * (lam1 - pre1))).max(zero);
+    let new1 = found.select(block1, seq1);
+    apply(c, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(new1 - lam1));
+    for (p, new) in c.points.iter_mut().zip([new0, new1]) {
+        p.normal_impulse = new;
+        p.max_normal_impulse = p.max_normal_impulse.max(new);
+        let lower = new.gt(zero) & p.substep_vn.lt(p.approach);
+        p.approach = lower.select(p.substep_vn, p.approach);
+    }
+    let pushed = (new0.gt(zero) | new1.gt(zero)).to_unit();
+    a.touched = a.touched.max(pushed);
+    b.touched = b.touched.max(pushed);
+
+    // Friction row (contact_solver::solve_friction).
+    let t = V4 { x: n.y, y: -n.x };
+    let (r_a, r_b) = lever_arms(c, d, c.friction_r_a, c.friction_r_b);
+    let mu = c.stick.select(c.mu_s, c.mu_d);
+    let limit = mu * (new0 + new1);
+    let vt = relative_velocity(&a, &b, r_a, r_b).dot(t) - c.tangent_speed;
+    let fbias = if USE_BIAS {
+        let drift = anchor_displacement(&a, &b, d, c.friction_r_a, c.friction_r_b).dot(t) + c.base_drift
+            - c.tangent_speed * F4::splat(elapsed);
+        let rate = c.bias_rate * drift;
+        (c.stick & limit.gt(zero)).select(rate.clamp(-push, push), zero)
+    } else {
+        zero
+    };
+    let old = c.tangent_impulse;
+    let unclamped = old + -(c.tangent_mass * (vt + fbias));
+    let new = unclamped.clamp(-limit, limit);
+    apply(c, &mut a, &mut b, r_a, r_b, t.scale(new - old));
+    c.tangent_impulse = new;
+    if !USE_BIAS {
+        c.saturated = limit.gt(zero) & unclamped.abs().gt(limit);
+        if c.any_rolling {
+            let rlimit = c.rolling_resistance * (new0 + new1);
+            let imp = -(c.rolling_mass * (b.w - a.w));
+            let rnew = (c.rolling_impulse + imp).clamp(-rlimit, rlimit);
+            let delta = rnew - c.rolling_impulse;
+            c.rolling_impulse = rnew;
+            a.w -= c.inv_i_a * delta;
+            b.w += c.inv_i_b * delta;
+        }
+    }
+    scatter(states, &c.index_a, &c.write_a, &a);
+    scatter(states, &c.index_b, &c.write_b, &b);
+}
+
+/// Adds a substep's impulses to the step totals.
+pub(crate) fn end_substep(c: &mut WideContact) {
+    for p in &mut c.points {
+        p.total_normal_impulse += p.normal_impulse;
+    }
+    c.total_tangent_impulse += c.tangent_impulse;
+}
+
+/// Where a scalar constraint lives during the substeps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Slot {
+    /// Lane `lane` of wide constraint `group`.
+    Wide { group: u32, lane: u8 },
+    /// Solved by the scalar code (no free colour).
+    Overflow,
+}
+
+/// Colours of one step: for each constraint (in the scalar list's order) its colour, or
+/// `None` for overflow. `moving[i]` tells whether state `i` is a dynamic body.
+pub(crate) fn color_constraints(
+    constraints: &[ContactConstraint],
+    moving: impl Fn(u32) -> bool,
+    body_count: usize,
+    out: &mut Vec<Option<u8>>,
+) {
+    let mut used = vec![0u32; body_count];
+    out.clear();
+    for cc in constraints {
+        let (ma, mb) = (moving(cc.index_a), moving(cc.index_b));
+        let busy = (if ma { used[cc.index_a as usize] } else { 0 }) | (if mb { used[cc.index_b as usize] } else { 0 });
+        let color = if ma && mb {
+            (0..DYNAMIC_COLORS).find(|&k| busy & (1 << k) == 0)
+        } else {
+            (1..COLORS).rev().find(|&k| busy & (1 << k) == 0)
+        };
+        if let Some(k) = color {
+            if ma {
+                used[cc.index_a as usize] |= 1 << k;
+            }
+            if mb {
+                used[cc.index_b as usize] |= 1 << k;
+            }
+        }
+        out.push(color.map(|k| k as u8));
+    }
+}
+
+/// Copies a scalar constraint into lane `l` (everything: geometry, masses, state).
+pub(crate) fn pack(w: &mut WideContact, l: usize, cc: &ContactConstraint, dynamic_a: bool, dynamic_b: bool) {
+    w.index_a[l] = cc.index_a;
+    w.index_b[l] = cc.index_b;
+    w.write_a[l] = dynamic_a && cc.index_a != 0;
+    w.write_b[l] = dynamic_b && cc.index_b != 0;
+    w.normal.x.0[l] = cc.normal.x;
+    w.normal.y.0[l] = cc.normal.y;
+    w.inv_mass_a.0[l] = cc.inv_mass_a;
+    w.inv_i_a.0[l] = cc.inv_i_a;
+    w.inv_mass_b.0[l] = cc.inv_mass_b;
+    w.inv_i_b.0[l] = cc.inv_i_b;
+    w.split.0[l] = cc.split;
+    w.mu_s.0[l] = cc.mu_s;
+    w.mu_d.0[l] = cc.mu_d;
+    w.tangent_speed.0[l] = cc.tangent_speed;
+    w.rolling_resistance.0[l] = cc.rolling_resistance;
+    w.rolling_mass.0[l] = cc.rolling_mass;
+    w.any_rolling |= cc.rolling_resistance > 0.0 || cc.rolling_impulse != 0.0;
+    let soft = cc.points[0].soft;
+    w.bias_rate.0[l] = soft.bias_rate;
+    w.mass_scale.0[l] = soft.mass_scale;
+    w.impulse_scale.0[l] = soft.impulse_scale;
+    for i in 0..2 {
+        let wp = &mut w.points[i];
+        if i < cc.count {
+            let cp = &cc.points[i];
+            wp.r_a.x.0[l] = cp.r_a.x;
+            wp.r_a.y.0[l] = cp.r_a.y;
+            wp.r_b.x.0[l] = cp.r_b.x;
+            wp.r_b.y.0[l] = cp.r_b.y;
+            wp.base_separation.0[l] = cp.base_separation;
+            wp.normal_mass.0[l] = cp.normal_mass;
+            wp.preload.0[l] = cp.preload;
+        } else {
+            // A point that does nothing: no mass, no anchors, no impulse (every product
+            // with its zero mass stays finite and zero).
+            for f in [
+                &mut wp.r_a.x,
+                &mut wp.r_a.y,
+                &mut wp.r_b.x,
+                &mut wp.r_b.y,
+                &mut wp.normal_mass,
+                &mut wp.preload,
+                &mut wp.base_separation,
+            ] {
+                f.0[l] = 0.0;
+            }
+        }
+    }
+    let block = cc.count == 2 && cc.block;
+    let k = if block { cc.k } else { [0.0; 3] };
+    let ik = if block { cc.inv_k } else { [0.0; 3] };
+    w.k11.0[l] = k[0];
+    w.k12.0[l] = k[1];
+    w.k22.0[l] = k[2];
+    w.i11.0[l] = ik[0];
+    w.i12.0[l] = ik[1];
+    w.i22.0[l] = ik[2];
+    w.inv_k11.0[l] = if block { 1.0 / k[0] } else { 0.0 };
+    w.inv_k22.0[l] = if block { 1.0 / k[2] } else { 0.0 };
+    w.block.0[l] = if block { u32::MAX } else { 0 };
+    let (p0, p1) = (&cc.points[0], &cc.points[1]);
+    let (fr_a, fr_b, tm, drift, stick, share) = match cc.count {
+        2 => (
+            0.5 * (p0.r_a + p1.r_a),
+            0.5 * (p0.r_b + p1.r_b),
+            cc.patch_tangent_mass,
+            0.5 * (p0.base_drift + p1.base_drift),
+            p0.stick && p1.stick,
+            [0.5, 0.5],
+        ),
+        1 => (p0.r_a, p0.r_b, p0.tangent_mass, p0.base_drift, p0.stick, [1.0, 0.0]),
+        _ => (Vec2::ZERO, Vec2::ZERO, 0.0, 0.0, true, [0.0, 0.0]),
+    };
+    w.friction_r_a.x.0[l] = fr_a.x;
+    w.friction_r_a.y.0[l] = fr_a.y;
+    w.friction_r_b.x.0[l] = fr_b.x;
+    w.friction_r_b.y.0[l] = fr_b.y;
+    w.tangent_mass.0[l] = tm;
+    w.base_drift.0[l] = drift;
+    w.stick.0[l] = if stick { u32::MAX } else { 0 };
+    w.tangent_share[0].0[l] = share[0];
+    w.tangent_share[1].0[l] = share[1];
+    pack_state(w, l, cc);
+}
+
+/// Copies the parts of a constraint that change during the substeps into lane `l`.
+pub(crate) fn pack_state(w: &mut WideContact, l: usize, cc: &ContactConstraint) {
+    for i in 0..2 {
+        let wp = &mut w.points[i];
+        let (lam, total, max, approach, vn) = if i < cc.count {
+            let cp = &cc.points[i];
+            (
+                cp.normal_impulse,
+                cp.total_normal_impulse,
+                cp.max_normal_impulse,
+                cp.approach,
+                cp.substep_vn,
+            )
+        } else {
+            (0.0, 0.0, 0.0, 0.0, 0.0)
+        };
+        wp.normal_impulse.0[l] = lam;
+        wp.total_normal_impulse.0[l] = total;
+        wp.max_normal_impulse.0[l] = max;
+        wp.approach.0[l] = approach;
+        wp.substep_vn.0[l] = vn;
+    }
+    let n = cc.count.min(2);
+    let sum_t: f32 = cc.points[..n].iter().map(|p| p.tangent_impulse).sum();
+    let sum_total_t: f32 = cc.points[..n].iter().map(|p| p.total_tangent_impulse).sum();
+    w.tangent_impulse.0[l] = sum_t;
+    w.total_tangent_impulse.0[l] = sum_total_t;
+    w.saturated.0[l] = if cc.points[0].saturated { u32::MAX } else { 0 };
+    w.rolling_impulse.0[l] = cc.rolling_impulse;
+}
+
+/// Copies lane `l`'s changing parts back into the scalar constraint.
+pub(crate) fn unpack_state(w: &WideContact, l: usize, cc: &mut ContactConstraint) {
+    let count = cc.count.min(2);
+    let share = if count == 2 { 0.5 } else { 1.0 };
+    let saturated = w.saturated.lane(l);
+    for i in 0..count {
+        let wp = &w.points[i];
+        let cp = &mut cc.points[i];
+        cp.normal_impulse = wp.normal_impulse.0[l];
+        cp.total_normal_impulse = wp.total_normal_impulse.0[l];
+        cp.max_normal_impulse = wp.max_normal_impulse.0[l];
+        cp.approach = wp.approach.0[l];
+        cp.substep_vn = wp.substep_vn.0[l];
+        cp.tangent_impulse = share * w.tangent_impulse.0[l];
+        cp.total_tangent_impulse = share * w.total_tangent_impulse.0[l];
+        cp.saturated = saturated;
+    }
+    cc.rolling_impulse = w.rolling_impulse.0[l];
+}
