@@ -52,9 +52,7 @@
 //! The two normal rows of a 2-point manifold are solved together (a 2×2 LCP, Box2D v2.4's
 //! block solver in soft form), so one iteration is exact within the manifold.
 
-use super::contact_wide::{self, Slot, WideContact, COLORS};
-use super::wide::LANES;
-use super::{BodyState, ConstraintSet, Softness, StepContext};
+use super::{BodyState, Softness, StepContext};
 use crate::collision::contact::{Contact, FrictionState};
 use crate::math::Vec2;
 
@@ -139,399 +137,325 @@ pub(crate) struct ConstraintBodies {
     pub center_b: Vec2,
 }
 
-/// All contact constraints of a step, in solve order.
-#[derive(Default)]
-pub(crate) struct ContactSolver {
-    pub constraints: Vec<ContactConstraint>,
-    /// Unit vector against gravity (zero without gravity).
-    pub up: Vec2,
-    /// Local groups for mass ratios: `groups[g]` is a range of `group_members`, the
-    /// constraints of one light body that carries a much heavier one.
-    groups: Vec<(u32, u32, u32)>,
-    group_members: Vec<u32>,
-    /// The coloured constraints, four per wide constraint, colour after colour.
-    wide: Vec<WideContact>,
-    /// `wide[colour_ranges[k].0 .. colour_ranges[k].1]` is colour k (non-empty colours).
-    colour_ranges: Vec<(u32, u32)>,
-    /// Constraints that found no colour (solved by the scalar code first in each pass).
-    overflow: Vec<u32>,
-    /// Where each constraint of `constraints` lives during the substeps.
-    slots: Vec<Slot>,
-    colours: Vec<Option<u8>>,
-}
-
-/// Whether a constraint side is a dynamic body (moves under impulses).
-#[inline]
-fn dynamic_side(inv_mass: f32, inv_i: f32) -> bool {
-    inv_mass > 0.0 || inv_i > 0.0
-}
-
-impl ContactSolver {
-    /// Builds the constraint of one touching contact (prepare stage, part 1).
-    pub fn push(&mut self, contact_index: u32, c: &Contact, bodies: &ConstraintBodies) {
-        let mut cc = ContactConstraint {
-            index_a: bodies.index_a,
-            index_b: bodies.index_b,
-            contact: contact_index,
-            normal: c.manifold.normal,
-            inv_mass_a: bodies.inv_mass_a,
-            inv_i_a: bodies.inv_i_a,
-            inv_mass_b: bodies.inv_mass_b,
-            inv_i_b: bodies.inv_i_b,
-            mu_s: c.material.friction_static,
-            mu_d: c.material.friction_dynamic,
-            restitution: c.material.restitution,
-            restitution_threshold: c.material.restitution_threshold,
-            rolling_resistance: c.material.rolling_resistance * c.rolling_radius,
-            rolling_mass: 0.0,
-            rolling_impulse: c.rolling_impulse,
-            tangent_speed: c.material.tangent_speed,
-            k: [0.0; 3],
-            inv_k: [0.0; 3],
-            block: false,
-            patch_tangent_mass: 0.0,
-            kinetic_energy: 0.0,
-            height: if c.manifold.count > 0 {
-                c.manifold.points[0].point.dot(self.up)
+/// Builds the scalar constraint of one touching contact: anchors, masses, the 2×2 block,
+/// softness, and the friction state of new points (which needs the body velocities).
+pub(crate) fn build_constraint(
+    contact_index: u32,
+    c: &Contact,
+    bodies: &ConstraintBodies,
+    up: Vec2,
+    soft: &StepSoftness,
+    ctx: &StepContext,
+    states: &[BodyState],
+) -> ContactConstraint {
+    let mut cc = ContactConstraint {
+        index_a: bodies.index_a,
+        index_b: bodies.index_b,
+        contact: contact_index,
+        normal: c.manifold.normal,
+        inv_mass_a: bodies.inv_mass_a,
+        inv_i_a: bodies.inv_i_a,
+        inv_mass_b: bodies.inv_mass_b,
+        inv_i_b: bodies.inv_i_b,
+        mu_s: c.material.friction_static,
+        mu_d: c.material.friction_dynamic,
+        restitution: c.material.restitution,
+        restitution_threshold: c.material.restitution_threshold,
+        rolling_resistance: c.material.rolling_resistance * c.rolling_radius,
+        rolling_mass: 0.0,
+        rolling_impulse: if ctx.warm_starting { c.rolling_impulse } else { 0.0 },
+        tangent_speed: c.material.tangent_speed,
+        k: [0.0; 3],
+        inv_k: [0.0; 3],
+        block: false,
+        patch_tangent_mass: 0.0,
+        kinetic_energy: 0.0,
+        height: if c.manifold.count > 0 {
+            c.manifold.points[0].point.dot(up)
+        } else {
+            0.0
+        },
+        split: {
+            let sum = bodies.inv_mass_a + bodies.inv_mass_b;
+            if sum > 0.0 {
+                bodies.inv_mass_b / sum
             } else {
-                0.0
-            },
-            split: {
-                let sum = bodies.inv_mass_a + bodies.inv_mass_b;
-                if sum > 0.0 {
-                    bodies.inv_mass_b / sum
-                } else {
-                    0.5
-                }
-            },
-            count: c.manifold.count,
-            points: [ConstraintPoint::default(); 2],
+                0.5
+            }
+        },
+        count: c.manifold.count,
+        points: [ConstraintPoint::default(); 2],
+    };
+    let k_roll = bodies.inv_i_a + bodies.inv_i_b;
+    cc.rolling_mass = if k_roll > 0.0 { 1.0 / k_roll } else { 0.0 };
+    let n = cc.normal;
+    let t = n.right_perp();
+    let masses = cc_masses(bodies);
+    let (sa, sb) = (states[cc.index_a as usize], states[cc.index_b as usize]);
+    if cc.restitution > 0.0 {
+        cc.kinetic_energy = pair_kinetic_energy(&cc, &sa, &sb);
+    }
+    // Contacts with static bodies are twice as stiff (Box2D v3's static softness).
+    let point_soft = if cc.index_a == 0 || cc.index_b == 0 {
+        soft.static_contact
+    } else {
+        soft.contact
+    };
+    for i in 0..cc.count {
+        let mp = &c.manifold.points[i];
+        let ps = &c.points[i];
+        let r_a = mp.point - bodies.center_a;
+        let r_b = mp.point - bodies.center_b;
+        let cp = &mut cc.points[i];
+        cp.r_a = r_a;
+        cp.r_b = r_b;
+        cp.base_separation = mp.separation;
+        cp.base_drift = if ps.state == FrictionState::Stick && !ps.fresh {
+            ps.drift
+        } else {
+            0.0
         };
-        let k_roll = bodies.inv_i_a + bodies.inv_i_b;
-        cc.rolling_mass = if k_roll > 0.0 { 1.0 / k_roll } else { 0.0 };
-        let n = cc.normal;
-        let t = n.right_perp();
-        let masses = cc_masses(bodies);
-        for i in 0..cc.count {
-            let mp = &c.manifold.points[i];
-            let ps = &c.points[i];
-            let r_a = mp.point - bodies.center_a;
-            let r_b = mp.point - bodies.center_b;
-            let cp = &mut cc.points[i];
-            cp.r_a = r_a;
-            cp.r_b = r_b;
-            cp.base_separation = mp.separation;
-            let drift = if ps.state == FrictionState::Stick && !ps.fresh {
-                ps.drift
-            } else {
-                0.0
-            };
-            cp.base_drift = drift;
-            cp.normal_mass = inv_or_zero(effective_mass_inv(&masses, r_a, r_b, n));
-            cp.tangent_mass = inv_or_zero(effective_mass_inv(&masses, r_a, r_b, t));
+        cp.normal_mass = inv_or_zero(effective_mass_inv(&masses, r_a, r_b, n));
+        cp.tangent_mass = inv_or_zero(effective_mass_inv(&masses, r_a, r_b, t));
+        if ctx.warm_starting {
             cp.normal_impulse = ps.normal_impulse;
             cp.tangent_impulse = ps.tangent_impulse;
-            cp.stick = ps.state == FrictionState::Stick;
-            cp.fresh = ps.fresh;
             cp.preload = ps.preload;
+        }
+        cp.stick = ps.state == FrictionState::Stick;
+        cp.fresh = ps.fresh;
+        cp.soft = point_soft;
+        if cp.fresh {
+            // A new point starts sliding only if it is already in contact and slipping.
+            let dv = relative_velocity(&sa, &sb, r_a, r_b);
+            let slip = (dv.dot(t) - cc.tangent_speed).abs();
+            let in_contact = cp.base_separation <= crate::geometry::LINEAR_SLOP;
+            cp.stick = !(in_contact && slip > ctx.stick_speed);
+        }
+    }
+    if cc.count == 2 {
+        let (p0, p1) = (&cc.points[0], &cc.points[1]);
+        let (rc_a, rc_b) = (0.5 * (p0.r_a + p1.r_a), 0.5 * (p0.r_b + p1.r_b));
+        cc.patch_tangent_mass = inv_or_zero(effective_mass_inv(&masses, rc_a, rc_b, t));
+        let (ra0, rb0, ra1, rb1) = (p0.r_a.cross(n), p0.r_b.cross(n), p1.r_a.cross(n), p1.r_b.cross(n));
+        let m = masses.ma + masses.mb;
+        let k11 = m + masses.ia * ra0 * ra0 + masses.ib * rb0 * rb0;
+        let k22 = m + masses.ia * ra1 * ra1 + masses.ib * rb1 * rb1;
+        let k12 = m + masses.ia * ra0 * ra1 + masses.ib * rb0 * rb1;
+        let det = k11 * k22 - k12 * k12;
+        // Box2D v2.4's guard: skip the block solve when K is near singular.
+        if k11 * k11 < 1000.0 * det && det > 0.0 {
+            let inv = 1.0 / det;
+            cc.k = [k11, k12, k22];
+            cc.inv_k = [k22 * inv, -k12 * inv, k11 * inv];
+            cc.block = true;
+        }
+    }
+    cc
+}
+
+/// The two softness settings of a step's contacts.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct StepSoftness {
+    /// Between two moving bodies.
+    pub contact: Softness,
+    /// Against a static body: twice the frequency.
+    pub static_contact: Softness,
+}
+
+impl StepSoftness {
+    pub fn new(ctx: &StepContext) -> StepSoftness {
+        StepSoftness {
+            contact: Softness::new(ctx.contact_hertz, ctx.contact_damping_ratio, ctx.h),
+            static_contact: Softness::new(2.0 * ctx.contact_hertz, ctx.contact_damping_ratio, ctx.h),
+        }
+    }
+}
+
+/// Whether any point of the constraint is new this step.
+pub(crate) fn has_fresh_point(cc: &ContactConstraint) -> bool {
+    cc.points[..cc.count].iter().any(|p| p.fresh)
+}
+
+/// Records each point's normal velocity under `states` (the approach speed of new points).
+pub(crate) fn record_approach(cc: &mut ContactConstraint, states: &[BodyState]) {
+    let (a, b) = load(states, cc.index_a, cc.index_b);
+    for i in 0..cc.count {
+        let (r_a, r_b) = (cc.points[i].r_a, cc.points[i].r_b);
+        cc.points[i].substep_vn = point_velocity(cc, &a, &b, r_a, r_b).dot(cc.normal);
+    }
+}
+
+/// Whether a constraint is new and resting: every point fresh, touching and not hitting
+/// (after [`record_approach`]).
+pub(crate) fn is_new_resting(cc: &ContactConstraint) -> bool {
+    cc.count > 0
+        && cc.points[..cc.count]
+            .iter()
+            .all(|p| p.fresh && p.base_separation <= crate::geometry::LINEAR_SLOP && p.substep_vn > -RESTING_SPEED)
+}
+
+/// Estimates warm-start impulses for new resting constraints (`subset`) by rigid sweeps
+/// against `trial`, the states after one substep of forces: first the top-down statics
+/// pass ([`statics_estimate`]), then sequential sweeps from the top down until the
+/// normal impulses settle. Sets each point's preload to its estimate.
+pub(crate) fn estimate(subset: &mut [ContactConstraint], up: Vec2, ctx: &StepContext, trial: &mut [BodyState]) {
+    if subset.is_empty() {
+        return;
+    }
+    // Top-down order: a sweep then carries the weight of a whole stack down to the
+    // ground at once (sequential impulses pass load one contact per sweep against the
+    // order).
+    subset.sort_by(|x, y| y.height.total_cmp(&x.height).then(x.contact.cmp(&y.contact)));
+    statics_estimate(subset, up, trial);
+    // Bound the work (the first step of a large scene pays it): at most
+    // ESTIMATE_BUDGET row solves, between 16 and MAX_ESTIMATE_SWEEPS sweeps.
+    let sweeps = (ESTIMATE_BUDGET / subset.len()).clamp(16, MAX_ESTIMATE_SWEEPS);
+    for _ in 0..sweeps {
+        let (mut change, mut largest) = (0.0f32, 0.0f32);
+        for cc in subset.iter_mut() {
+            let before = [cc.points[0].normal_impulse, cc.points[1].normal_impulse];
+            solve_one(cc, trial, ctx, false, 0.0);
+            for (k, cp) in cc.points[..cc.count].iter().enumerate() {
+                change = change.max((cp.normal_impulse - before[k]).abs());
+                largest = largest.max(cp.normal_impulse);
+            }
+        }
+        if change <= ESTIMATE_TOLERANCE * largest || change < 1e-9 {
+            break;
+        }
+    }
+    for cc in subset.iter_mut() {
+        for cp in &mut cc.points[..cc.count] {
+            cp.preload = cp.normal_impulse;
+            cp.max_normal_impulse = 0.0;
             cp.approach = 0.0;
-        }
-        if cc.count == 2 {
-            let (p0, p1) = (&cc.points[0], &cc.points[1]);
-            let (rc_a, rc_b) = (0.5 * (p0.r_a + p1.r_a), 0.5 * (p0.r_b + p1.r_b));
-            cc.patch_tangent_mass = inv_or_zero(effective_mass_inv(&masses, rc_a, rc_b, t));
-            let (ra0, rb0, ra1, rb1) = (p0.r_a.cross(n), p0.r_b.cross(n), p1.r_a.cross(n), p1.r_b.cross(n));
-            let m = masses.ma + masses.mb;
-            let k11 = m + masses.ia * ra0 * ra0 + masses.ib * rb0 * rb0;
-            let k22 = m + masses.ia * ra1 * ra1 + masses.ib * rb1 * rb1;
-            let k12 = m + masses.ia * ra0 * ra1 + masses.ib * rb0 * rb1;
-            let det = k11 * k22 - k12 * k12;
-            // Box2D v2.4's guard: skip the block solve when K is near singular.
-            if k11 * k11 < 1000.0 * det && det > 0.0 {
-                let inv = 1.0 / det;
-                cc.k = [k11, k12, k22];
-                cc.inv_k = [k22 * inv, -k12 * inv, k11 * inv];
-                cc.block = true;
-            }
-        }
-        self.constraints.push(cc);
-    }
-
-    /// Finds light bodies that touch a much heavier moving body and groups each one's
-    /// constraints for extra local sweeps. Sequential impulses move momentum through a
-    /// light body between a heavy one and the ground only at a rate of about m/M per
-    /// sweep, so a 100:1 stack needs ~100 sweeps where one is enough for equal masses.
-    /// Sweeps per pass: ⌈M/m⌉, capped at [`MAX_LOCAL_SWEEPS`].
-    fn build_mass_ratio_groups(&mut self) {
-        self.groups.clear();
-        self.group_members.clear();
-        let mut light: Vec<(u32, u32)> = Vec::new(); // (light body index, sweeps)
-        for cc in &self.constraints {
-            if cc.inv_mass_a > 0.0 && cc.inv_mass_b > 0.0 {
-                let (ratio, body) = if cc.inv_mass_a > cc.inv_mass_b {
-                    (cc.inv_mass_a / cc.inv_mass_b, cc.index_a)
-                } else {
-                    (cc.inv_mass_b / cc.inv_mass_a, cc.index_b)
-                };
-                if ratio > MASS_RATIO_GROUP {
-                    let sweeps = (ratio.ceil() as u32).min(MAX_LOCAL_SWEEPS);
-                    light.push((body, sweeps));
-                }
-            }
-        }
-        if light.is_empty() {
-            return;
-        }
-        light.sort_unstable();
-        light.dedup_by(|x, y| {
-            if x.0 == y.0 {
-                y.1 = y.1.max(x.1);
-                true
-            } else {
-                false
-            }
-        });
-        for &(body, sweeps) in &light {
-            let start = self.group_members.len() as u32;
-            for (ci, cc) in self.constraints.iter().enumerate() {
-                if cc.index_a == body || cc.index_b == body {
-                    self.group_members.push(ci as u32);
-                }
-            }
-            self.groups.push((start, self.group_members.len() as u32, sweeps));
+            cp.saturated = false;
         }
     }
+}
 
-    /// Colours the constraints and packs them into wide constraints (after the estimate,
-    /// before the substeps).
-    fn pack(&mut self, body_count: usize) {
-        let mut dynamic = vec![false; body_count];
-        for cc in &self.constraints {
-            dynamic[cc.index_a as usize] |= dynamic_side(cc.inv_mass_a, cc.inv_i_a);
-            dynamic[cc.index_b as usize] |= dynamic_side(cc.inv_mass_b, cc.inv_i_b);
-        }
-        dynamic[0] = false;
-        contact_wide::color_constraints(
-            &self.constraints,
-            |i| dynamic[i as usize],
-            body_count,
-            &mut self.colours,
-        );
-        let mut by_colour: [Vec<u32>; COLORS] = Default::default();
-        self.overflow.clear();
-        for (i, colour) in self.colours.iter().enumerate() {
-            match colour {
-                Some(k) => by_colour[*k as usize].push(i as u32),
-                None => self.overflow.push(i as u32),
-            }
-        }
-        self.wide.clear();
-        self.colour_ranges.clear();
-        self.slots.clear();
-        self.slots.resize(self.constraints.len(), Slot::Overflow);
-        for members in by_colour.iter().filter(|m| !m.is_empty()) {
-            let start = self.wide.len() as u32;
-            for chunk in members.chunks(LANES) {
-                let mut w = WideContact::default();
-                for (l, &ci) in chunk.iter().enumerate() {
-                    let cc = &self.constraints[ci as usize];
-                    let (da, db) = (dynamic[cc.index_a as usize], dynamic[cc.index_b as usize]);
-                    contact_wide::pack(&mut w, l, cc, da, db);
-                    self.slots[ci as usize] = Slot::Wide {
-                        group: self.wide.len() as u32,
-                        lane: l as u8,
-                    };
-                }
-                self.wide.push(w);
-            }
-            self.colour_ranges.push((start, self.wide.len() as u32));
+/// First guess of the estimate: the loads of a rigid structure at rest, passed from the
+/// top down (`subset` sorted by height, highest first). Each body that rests on
+/// supports below it (contacts whose normal is within 60° of "up") carries its own
+/// weight plus what the bodies above put on it; the total is shared between its
+/// outermost supports by the lever rule (the two reactions whose moments about the
+/// load's line of action balance: `w_hi = W (c − x_lo) / (x_hi − x_lo)`), evenly between
+/// the points of one manifold, and passed on to the supporting bodies. This is exact
+/// for stacks and pyramids (statically determinate per body) and a good start for piles;
+/// the rigid sweeps that follow correct it. Sequential sweeps alone need on the order of
+/// N² sweeps to carry the weight of an N-high stack to the ground.
+pub(crate) fn statics_estimate(subset: &mut [ContactConstraint], up: Vec2, trial: &mut [BodyState]) {
+    if up == Vec2::ZERO {
+        return;
+    }
+    let lat = up.right_perp();
+    let n_states = trial.len();
+    // Supports of each upper body, in subset order: (upper state, constraint, upper is B).
+    let mut supports: Vec<(u32, usize, bool)> = Vec::new();
+    for (i, cc) in subset.iter().enumerate() {
+        let up_n = cc.normal.dot(up);
+        let (upper, upper_is_b, inv_m) = if up_n > 0.5 {
+            (cc.index_b, true, cc.inv_mass_b)
+        } else if up_n < -0.5 {
+            (cc.index_a, false, cc.inv_mass_a)
+        } else {
+            continue;
+        };
+        if upper != 0 && inv_m > 0.0 {
+            supports.push((upper, i, upper_is_b));
         }
     }
-
-    /// Copies the wide constraints' impulses back into `constraints`.
-    fn unpack(&mut self) {
-        for (cc, slot) in self.constraints.iter_mut().zip(&self.slots) {
-            if let Slot::Wide { group, lane } = *slot {
-                contact_wide::unpack_state(&self.wide[group as usize], lane as usize, cc);
-            }
-        }
+    if supports.is_empty() {
+        return;
     }
-
-    /// One scalar pass over constraint `ci` wherever it lives.
-    fn solve_scalar(&mut self, ci: usize, states: &mut [BodyState], ctx: &StepContext, use_bias: bool, elapsed: f32) {
-        let cc = &mut self.constraints[ci];
-        match self.slots[ci] {
-            Slot::Wide { group, lane } => {
-                let w = &mut self.wide[group as usize];
-                contact_wide::unpack_state(w, lane as usize, cc);
-                solve_one(cc, states, ctx, use_bias, elapsed);
-                contact_wide::pack_state(w, lane as usize, cc);
-            }
-            Slot::Overflow => solve_one(cc, states, ctx, use_bias, elapsed),
-        }
+    // Order of first appearance (highest support first) for each upper body.
+    let mut first = vec![u32::MAX; n_states];
+    for (k, s) in supports.iter().enumerate() {
+        let f = &mut first[s.0 as usize];
+        *f = (*f).min(k as u32);
     }
-
-    /// First guess of the estimate: the loads of a rigid structure at rest, passed from the
-    /// top down (`subset` sorted by height, highest first). Each body that rests on
-    /// supports below it (contacts whose normal is within 60° of "up") carries its own
-    /// weight plus what the bodies above put on it; the total is shared between its
-    /// outermost supports by the lever rule (the two reactions whose moments about the
-    /// load's line of action balance: `w_hi = W (c − x_lo) / (x_hi − x_lo)`), evenly between
-    /// the points of one manifold, and passed on to the supporting bodies. This is exact
-    /// for stacks and pyramids (statically determinate per body) and a good start for piles;
-    /// the rigid sweeps that follow correct it. Sequential sweeps alone need on the order of
-    /// N² sweeps to carry the weight of an N-high stack to the ground.
-    fn statics_estimate(&mut self, subset: &[usize], trial: &mut [BodyState]) {
-        let up = self.up;
-        if up == Vec2::ZERO {
-            return;
+    supports.sort_by_key(|s| (first[s.0 as usize], s.1));
+    let mut load = vec![0.0f32; n_states];
+    let mut moment = vec![0.0f32; n_states];
+    let mut start = 0;
+    while start < supports.len() {
+        let upper = supports[start].0;
+        let mut end = start;
+        while end < supports.len() && supports[end].0 == upper {
+            end += 1;
         }
-        let lat = up.right_perp();
-        let n_states = trial.len();
-        // Supports of each upper body, in subset order: (upper state, constraint, upper is B).
-        let mut supports: Vec<(u32, usize, bool)> = Vec::new();
-        for &i in subset {
-            let cc = &self.constraints[i];
-            let up_n = cc.normal.dot(up);
-            let (upper, upper_is_b, inv_m) = if up_n > 0.5 {
-                (cc.index_b, true, cc.inv_mass_b)
-            } else if up_n < -0.5 {
-                (cc.index_a, false, cc.inv_mass_a)
-            } else {
-                continue;
-            };
-            if upper != 0 && inv_m > 0.0 {
-                supports.push((upper, i, upper_is_b));
+        let group = &supports[start..end];
+        start = end;
+        let (i0, b0) = (group[0].1, group[0].2);
+        let inv_m = if b0 {
+            subset[i0].inv_mass_b
+        } else {
+            subset[i0].inv_mass_a
+        };
+        // Own weight: the impulse that stops this substep's fall, acting at the centre.
+        let fall = (-trial[upper as usize].v.dot(up)).max(0.0);
+        let own = fall / inv_m;
+        let w_total = own + load[upper as usize];
+        if w_total <= 0.0 {
+            continue;
+        }
+        let c = moment[upper as usize] / w_total;
+        // Lateral position of each support (mean of its points) from the upper centre.
+        let x_of = |cc: &ContactConstraint, upper_is_b: bool| {
+            let sum: f32 = cc.points[..cc.count]
+                .iter()
+                .map(|p| if upper_is_b { p.r_b } else { p.r_a }.dot(lat))
+                .sum();
+            sum / cc.count as f32
+        };
+        let (mut lo, mut hi) = (0usize, 0usize);
+        let xs: Vec<f32> = group.iter().map(|s| x_of(&subset[s.1], s.2)).collect();
+        for k in 0..xs.len() {
+            if xs[k] < xs[lo] {
+                lo = k;
+            }
+            if xs[k] > xs[hi] {
+                hi = k;
             }
         }
-        if supports.is_empty() {
-            return;
+        let mut shares = vec![0.0f32; group.len()];
+        if xs[hi] - xs[lo] < 1e-6 {
+            shares.iter_mut().for_each(|s| *s = w_total / group.len() as f32);
+        } else {
+            let w_hi = (w_total * (c - xs[lo]) / (xs[hi] - xs[lo])).clamp(0.0, w_total);
+            shares[hi] = w_hi;
+            shares[lo] = w_total - w_hi;
         }
-        // Order of first appearance (highest support first) for each upper body.
-        let mut first = vec![u32::MAX; n_states];
-        for (k, s) in supports.iter().enumerate() {
-            let f = &mut first[s.0 as usize];
-            *f = (*f).min(k as u32);
-        }
-        supports.sort_by_key(|s| (first[s.0 as usize], s.1));
-        let mut load = vec![0.0f32; n_states];
-        let mut moment = vec![0.0f32; n_states];
-        let mut start = 0;
-        while start < supports.len() {
-            let upper = supports[start].0;
-            let mut end = start;
-            while end < supports.len() && supports[end].0 == upper {
-                end += 1;
+        for (k, &(_, ci, upper_is_b)) in group.iter().enumerate() {
+            let w = shares[k];
+            let cc = &mut subset[ci];
+            let up_n = cc.normal.dot(up).abs();
+            let count = cc.count;
+            for cp in &mut cc.points[..count] {
+                cp.normal_impulse = w / (count as f32 * up_n);
             }
-            let group = &supports[start..end];
-            start = end;
-            let (i0, b0) = (group[0].1, group[0].2);
-            let inv_m = if b0 {
-                self.constraints[i0].inv_mass_b
-            } else {
-                self.constraints[i0].inv_mass_a
-            };
-            // Own weight: the impulse that stops this substep's fall, acting at the centre.
-            let fall = (-trial[upper as usize].v.dot(up)).max(0.0);
-            let own = fall / inv_m;
-            let w_total = own + load[upper as usize];
-            if w_total <= 0.0 {
-                continue;
-            }
-            let c = moment[upper as usize] / w_total;
-            // Lateral position of each support (mean of its points) from the upper centre.
-            let x_of = |cc: &ContactConstraint, upper_is_b: bool| {
-                let sum: f32 = cc.points[..cc.count]
+            let lower = if upper_is_b { cc.index_a } else { cc.index_b };
+            if lower != 0 {
+                // The reaction's lateral position seen from the lower body's centre.
+                let x_lower: f32 = cc.points[..count]
                     .iter()
-                    .map(|p| if upper_is_b { p.r_b } else { p.r_a }.dot(lat))
-                    .sum();
-                sum / cc.count as f32
-            };
-            let (mut lo, mut hi) = (0usize, 0usize);
-            let xs: Vec<f32> = group.iter().map(|s| x_of(&self.constraints[s.1], s.2)).collect();
-            for k in 0..xs.len() {
-                if xs[k] < xs[lo] {
-                    lo = k;
-                }
-                if xs[k] > xs[hi] {
-                    hi = k;
-                }
+                    .map(|p| if upper_is_b { p.r_a } else { p.r_b }.dot(lat))
+                    .sum::<f32>()
+                    / count as f32;
+                load[lower as usize] += w;
+                moment[lower as usize] += w * x_lower;
             }
-            let mut shares = vec![0.0f32; group.len()];
-            if xs[hi] - xs[lo] < 1e-6 {
-                shares.iter_mut().for_each(|s| *s = w_total / group.len() as f32);
-            } else {
-                let w_hi = (w_total * (c - xs[lo]) / (xs[hi] - xs[lo])).clamp(0.0, w_total);
-                shares[hi] = w_hi;
-                shares[lo] = w_total - w_hi;
-            }
-            for (k, &(_, ci, upper_is_b)) in group.iter().enumerate() {
-                let w = shares[k];
-                let cc = &mut self.constraints[ci];
-                let up_n = cc.normal.dot(up).abs();
-                let count = cc.count;
-                for cp in &mut cc.points[..count] {
-                    cp.normal_impulse = w / (count as f32 * up_n);
-                }
-                let lower = if upper_is_b { cc.index_a } else { cc.index_b };
-                if lower != 0 {
-                    // The reaction's lateral position seen from the lower body's centre.
-                    let x_lower: f32 = cc.points[..count]
-                        .iter()
-                        .map(|p| if upper_is_b { p.r_a } else { p.r_b }.dot(lat))
-                        .sum::<f32>()
-                        / count as f32;
-                    load[lower as usize] += w;
-                    moment[lower as usize] += w * x_lower;
-                }
-            }
-        }
-        // The trial velocities must carry the impulses the sweeps start from.
-        for &(_, ci, _) in &supports {
-            let cc = &self.constraints[ci];
-            let (mut a, mut b) = load_states(trial, cc.index_a, cc.index_b);
-            for cp in &cc.points[..cc.count] {
-                apply(cc, &mut a, &mut b, cp.r_a, cp.r_b, cp.normal_impulse * cc.normal);
-            }
-            store(trial, cc.index_a, cc.index_b, a, b);
         }
     }
-
-    /// Resolves per-point softness and the state of new points (prepare stage, part 2),
-    /// once body velocities are known.
-    fn prepare_points(&mut self, ctx: &StepContext, states: &[BodyState]) {
-        for cc in self.constraints.iter_mut() {
-            let (sa, sb) = (states[cc.index_a as usize], states[cc.index_b as usize]);
-            let has_static = cc.index_a == 0 || cc.index_b == 0;
-            if cc.restitution > 0.0 {
-                cc.kinetic_energy = pair_kinetic_energy(cc, &sa, &sb);
-            }
-            // Contacts with static bodies are twice as stiff (Box2D v3's static softness).
-            let hertz = if has_static {
-                2.0 * ctx.contact_hertz
-            } else {
-                ctx.contact_hertz
-            };
-            let n = cc.normal;
-            let t = n.right_perp();
-            for cp in cc.points[..cc.count].iter_mut() {
-                if !ctx.warm_starting {
-                    cp.preload = 0.0;
-                }
-                if !ctx.warm_starting {
-                    cc.rolling_impulse = 0.0;
-                    cp.normal_impulse = 0.0;
-                    cp.tangent_impulse = 0.0;
-                }
-                cp.soft = Softness::new(hertz, ctx.contact_damping_ratio, ctx.h);
-                if cp.fresh {
-                    let dv = relative_velocity(&sa, &sb, cp.r_a, cp.r_b);
-                    let slip = (dv.dot(t) - cc.tangent_speed).abs();
-                    let in_contact = cp.base_separation <= crate::geometry::LINEAR_SLOP;
-                    cp.stick = !(in_contact && slip > ctx.stick_speed);
-                }
-            }
+    // The trial velocities must carry the impulses the sweeps start from.
+    for &(_, ci, _) in &supports {
+        let cc = &subset[ci];
+        let (mut a, mut b) = load_states(trial, cc.index_a, cc.index_b);
+        for cp in &cc.points[..cc.count] {
+            apply(cc, &mut a, &mut b, cp.r_a, cp.r_b, cp.normal_impulse * cc.normal);
         }
+        store(trial, cc.index_a, cc.index_b, a, b);
     }
 }
 
@@ -644,10 +568,10 @@ const ESTIMATE_TOLERANCE: f32 = 1e-4;
 const RESTING_SPEED: f32 = 0.5;
 
 /// Mass ratio above which a light body's constraints get extra local sweeps.
-const MASS_RATIO_GROUP: f32 = 4.0;
+pub(crate) const MASS_RATIO_GROUP: f32 = 4.0;
 
 /// Most extra local sweeps per pass for one light body.
-const MAX_LOCAL_SWEEPS: u32 = 64;
+pub(crate) const MAX_LOCAL_SWEEPS: u32 = 64;
 
 /// Inverse masses of a constraint's bodies.
 struct Masses {
@@ -766,216 +690,86 @@ fn store(states: &mut [BodyState], ia: u32, ib: u32, a: BodyState, b: BodyState)
     }
 }
 
-impl ConstraintSet for ContactSolver {
-    fn prepare(&mut self, ctx: &StepContext, states: &[BodyState]) {
-        // Geometry and masses were filled by `push`; softness and new points' states
-        // need the body velocities.
-        self.prepare_points(ctx, states);
-        self.build_mass_ratio_groups();
+/// Restitution for one constraint (after all substeps): points that approached faster
+/// than the threshold and took load bounce with `e` times their approach speed.
+pub(crate) fn restitution_one(cc: &mut ContactConstraint, states: &mut [BodyState]) {
+    if cc.restitution == 0.0 {
+        return;
     }
-
-    fn warm_start(&mut self, states: &mut [BodyState]) {
-        for &ci in &self.overflow {
-            warm_start_one(&mut self.constraints[ci as usize], states);
+    let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
+    let n = cc.normal;
+    let bounces = |p: &ConstraintPoint| p.approach <= -cc.restitution_threshold && p.max_normal_impulse > 0.0;
+    if cc.count == 2 && cc.block && bounces(&cc.points[0]) && bounces(&cc.points[1]) {
+        // Both points of a face bounce: solve them together, or the second point's
+        // impulse would add to the rebound the first already set (energy gain).
+        let mut rows = [NormalRow::default(); 2];
+        for (row, cp) in rows.iter_mut().zip(&cc.points) {
+            *row = NormalRow {
+                vn: point_velocity(cc, &a, &b, cp.r_a, cp.r_b).dot(n),
+                bias: cc.restitution * cp.approach,
+                mass_scale: 1.0,
+                impulse_scale: 0.0,
+            };
         }
-        for w in &mut self.wide {
-            contact_wide::warm_start(w, states);
-        }
-    }
-
-    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, elapsed: f32) {
-        for &ci in &self.overflow {
-            solve_one(&mut self.constraints[ci as usize], states, ctx, use_bias, elapsed);
-        }
-        for w in &mut self.wide {
-            if use_bias {
-                contact_wide::solve::<true>(w, states, ctx, elapsed);
-            } else {
-                contact_wide::solve::<false>(w, states, ctx, elapsed);
-            }
-        }
-        // Extra local sweeps where a light body carries a heavy one, in the relax pass only:
-        // the soft rows of the biased pass are formulated for exactly one sweep (each
-        // sweep relaxes the impulse towards its preload).
-        if use_bias {
-            return;
-        }
-        for g in 0..self.groups.len() {
-            let (start, end, sweeps) = self.groups[g];
-            for _ in 0..sweeps {
-                for m in start..end {
-                    let ci = self.group_members[m as usize] as usize;
-                    self.solve_scalar(ci, states, ctx, use_bias, elapsed);
-                }
-            }
-        }
-    }
-
-    fn has_new_contacts(&self) -> bool {
-        self.constraints
-            .iter()
-            .any(|cc| cc.points[..cc.count].iter().any(|p| p.fresh))
-    }
-
-    fn record_approach(&mut self, states: &[BodyState]) {
-        for cc in &mut self.constraints {
-            let (a, b) = load(states, cc.index_a, cc.index_b);
-            for i in 0..cc.count {
-                let (r_a, r_b) = (cc.points[i].r_a, cc.points[i].r_b);
-                cc.points[i].substep_vn = point_velocity(cc, &a, &b, r_a, r_b).dot(cc.normal);
-            }
-        }
-    }
-
-    fn estimate_new_contacts(&mut self, ctx: &StepContext, trial: &mut [BodyState]) -> bool {
-        // Contacts that are new and resting: every point fresh, touching and not hitting.
-        let mut subset = Vec::new();
-        for (i, cc) in self.constraints.iter().enumerate() {
-            let resting = cc.points[..cc.count]
-                .iter()
-                .all(|p| p.fresh && p.base_separation <= crate::geometry::LINEAR_SLOP && p.substep_vn > -RESTING_SPEED);
-            if cc.count > 0 && resting {
-                subset.push(i);
-            }
-        }
-        if subset.is_empty() {
-            return false;
-        }
-        // Top-down order: a sweep then carries the weight of a whole stack down to the
-        // ground at once (sequential impulses pass load one contact per sweep against the
-        // order). Sweep until the normal impulses settle.
-        let constraints = &self.constraints;
-        subset.sort_by(|&x, &y| constraints[y].height.total_cmp(&constraints[x].height).then(x.cmp(&y)));
-        // Bound the work (the first step of a large scene pays it): at most
-        // ESTIMATE_BUDGET row solves, between 16 and MAX_ESTIMATE_SWEEPS sweeps.
-        let sweeps = (ESTIMATE_BUDGET / subset.len()).clamp(16, MAX_ESTIMATE_SWEEPS);
-        self.statics_estimate(&subset, trial);
-        for _ in 0..sweeps {
-            let (mut change, mut largest) = (0.0f32, 0.0f32);
-            for &i in &subset {
-                let cc = &mut self.constraints[i];
-                let before = [cc.points[0].normal_impulse, cc.points[1].normal_impulse];
-                solve_one(cc, trial, ctx, false, 0.0);
-                for (k, cp) in cc.points[..cc.count].iter().enumerate() {
-                    change = change.max((cp.normal_impulse - before[k]).abs());
-                    largest = largest.max(cp.normal_impulse);
-                }
-            }
-            if change <= ESTIMATE_TOLERANCE * largest || change < 1e-9 {
-                break;
-            }
-        }
-        for &i in &subset {
-            let cc = &mut self.constraints[i];
-            for cp in &mut cc.points[..cc.count] {
-                cp.preload = cp.normal_impulse;
-                cp.max_normal_impulse = 0.0;
-                cp.approach = 0.0;
-                cp.saturated = false;
-            }
-        }
-        true
-    }
-
-    fn end_substep(&mut self) {
-        for &ci in &self.overflow {
-            let cc = &mut self.constraints[ci as usize];
-            for cp in &mut cc.points[..cc.count] {
-                cp.total_normal_impulse += cp.normal_impulse;
-                cp.total_tangent_impulse += cp.tangent_impulse;
-            }
-        }
-        for w in &mut self.wide {
-            contact_wide::end_substep(w);
-        }
-    }
-
-    fn begin_substeps(&mut self, body_count: usize) {
-        self.pack(body_count);
-    }
-
-    fn restitution(&mut self, states: &mut [BodyState]) {
-        self.unpack();
-        for cc in &mut self.constraints {
-            if cc.restitution == 0.0 {
-                continue;
-            }
-            let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
-            let n = cc.normal;
-            let bounces = |p: &ConstraintPoint| p.approach <= -cc.restitution_threshold && p.max_normal_impulse > 0.0;
-            if cc.count == 2 && cc.block && bounces(&cc.points[0]) && bounces(&cc.points[1]) {
-                // Both points of a face bounce: solve them together, or the second point's
-                // impulse would add to the rebound the first already set (energy gain).
-                let mut rows = [NormalRow::default(); 2];
-                for (row, cp) in rows.iter_mut().zip(&cc.points) {
-                    *row = NormalRow {
-                        vn: point_velocity(cc, &a, &b, cp.r_a, cp.r_b).dot(n),
-                        bias: cc.restitution * cp.approach,
-                        mass_scale: 1.0,
-                        impulse_scale: 0.0,
-                    };
-                }
-                if let Some(x) = solve_block(cc, &rows) {
-                    for (i, &xi) in x.iter().enumerate() {
-                        let cp = cc.points[i];
-                        apply(cc, &mut a, &mut b, cp.r_a, cp.r_b, (xi - cp.normal_impulse) * n);
-                        let cp = &mut cc.points[i];
-                        cp.total_normal_impulse += xi - cp.normal_impulse;
-                        cp.normal_impulse = xi;
-                        cp.max_normal_impulse = cp.max_normal_impulse.max(xi);
-                    }
-                    store(states, cc.index_a, cc.index_b, a, b);
-                    continue;
-                }
-            }
-            for i in 0..cc.count {
+        if let Some(x) = solve_block(cc, &rows) {
+            for (i, &xi) in x.iter().enumerate() {
                 let cp = cc.points[i];
-                if !bounces(&cp) {
-                    continue;
-                }
-                let vn = point_velocity(cc, &a, &b, cp.r_a, cp.r_b).dot(n);
-                // Effective mass at the lever arms the impulse will act through now.
-                let (r_a, r_b) = lever_arms(cc, &a, &b, cp.r_a, cp.r_b);
-                let masses = Masses {
-                    ma: cc.inv_mass_a,
-                    ia: cc.inv_i_a,
-                    mb: cc.inv_mass_b,
-                    ib: cc.inv_i_b,
-                };
-                let normal_mass = inv_or_zero(effective_mass_inv(&masses, r_a, r_b, n));
-                let mut impulse = -normal_mass * (vn + cc.restitution * cp.approach);
-                // Never bounce back with more energy than the pair had before the step:
-                // along n the pair's energy is KE + λ·vn + λ²/(2 m_n); keep it ≤ KE₀.
-                // (The impact speed and the lever arms are sampled at slightly different
-                // moments of the step, which could otherwise add a little energy.)
-                if impulse > 0.0 && normal_mass > 0.0 {
-                    let ke = pair_kinetic_energy(cc, &a, &b);
-                    let room = cc.kinetic_energy - ke;
-                    // λ²/(2 m_n) + λ vn − room ≤ 0 → λ ≤ m_n (−vn + √(vn² + 2 room / m_n))
-                    let disc = vn * vn + 2.0 * room / normal_mass;
-                    let max = if disc > 0.0 {
-                        normal_mass * (-vn + disc.sqrt())
-                    } else {
-                        0.0
-                    };
-                    impulse = impulse.min(max.max(0.0));
-                }
-                let new = (cp.normal_impulse + impulse).max(0.0);
-                let delta = new - cp.normal_impulse;
-                apply(cc, &mut a, &mut b, cp.r_a, cp.r_b, delta * n);
+                apply(cc, &mut a, &mut b, cp.r_a, cp.r_b, (xi - cp.normal_impulse) * n);
                 let cp = &mut cc.points[i];
-                cp.normal_impulse = new;
-                cp.total_normal_impulse += delta;
-                cp.max_normal_impulse = cp.max_normal_impulse.max(new);
+                cp.total_normal_impulse += xi - cp.normal_impulse;
+                cp.normal_impulse = xi;
+                cp.max_normal_impulse = cp.max_normal_impulse.max(xi);
             }
             store(states, cc.index_a, cc.index_b, a, b);
+            return;
         }
     }
+    for i in 0..cc.count {
+        let cp = cc.points[i];
+        if !bounces(&cp) {
+            continue;
+        }
+        let vn = point_velocity(cc, &a, &b, cp.r_a, cp.r_b).dot(n);
+        // Effective mass at the lever arms the impulse will act through now.
+        let (r_a, r_b) = lever_arms(cc, &a, &b, cp.r_a, cp.r_b);
+        let masses = Masses {
+            ma: cc.inv_mass_a,
+            ia: cc.inv_i_a,
+            mb: cc.inv_mass_b,
+            ib: cc.inv_i_b,
+        };
+        let normal_mass = inv_or_zero(effective_mass_inv(&masses, r_a, r_b, n));
+        let mut impulse = -normal_mass * (vn + cc.restitution * cp.approach);
+        // Never bounce back with more energy than the pair had before the step:
+        // along n the pair's energy is KE + λ·vn + λ²/(2 m_n); keep it ≤ KE₀.
+        // (The impact speed and the lever arms are sampled at slightly different
+        // moments of the step, which could otherwise add a little energy.)
+        if impulse > 0.0 && normal_mass > 0.0 {
+            let ke = pair_kinetic_energy(cc, &a, &b);
+            let room = cc.kinetic_energy - ke;
+            // λ²/(2 m_n) + λ vn − room ≤ 0 → λ ≤ m_n (−vn + √(vn² + 2 room / m_n))
+            let disc = vn * vn + 2.0 * room / normal_mass;
+            let max = if disc > 0.0 {
+                normal_mass * (-vn + disc.sqrt())
+            } else {
+                0.0
+            };
+            impulse = impulse.min(max.max(0.0));
+        }
+        let new = (cp.normal_impulse + impulse).max(0.0);
+        let delta = new - cp.normal_impulse;
+        apply(cc, &mut a, &mut b, cp.r_a, cp.r_b, delta * n);
+        let cp = &mut cc.points[i];
+        cp.normal_impulse = new;
+        cp.total_normal_impulse += delta;
+        cp.max_normal_impulse = cp.max_normal_impulse.max(new);
+    }
+    store(states, cc.index_a, cc.index_b, a, b);
 }
 
 /// Re-applies one constraint's accumulated impulses at the start of a substep, after
 /// recording its points' normal velocities (restitution's impact speed).
-fn warm_start_one(cc: &mut ContactConstraint, states: &mut [BodyState]) {
+pub(crate) fn warm_start_one(cc: &mut ContactConstraint, states: &mut [BodyState]) {
     let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
     let n = cc.normal;
     let t = n.right_perp();
@@ -993,7 +787,13 @@ fn warm_start_one(cc: &mut ContactConstraint, states: &mut [BodyState]) {
 }
 
 /// One pass over one contact: normal rows, friction rows, rolling resistance.
-fn solve_one(cc: &mut ContactConstraint, states: &mut [BodyState], ctx: &StepContext, use_bias: bool, elapsed: f32) {
+pub(crate) fn solve_one(
+    cc: &mut ContactConstraint,
+    states: &mut [BodyState],
+    ctx: &StepContext,
+    use_bias: bool,
+    elapsed: f32,
+) {
     let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
     solve_normals(cc, &mut a, &mut b, ctx, use_bias);
     if cc.points[..cc.count].iter().any(|p| p.normal_impulse > 0.0) {
@@ -1197,5 +997,13 @@ pub(crate) fn store_impulses(cc: &ContactConstraint, contact: &mut Contact, stat
         } else {
             FrictionState::Slip
         };
+    }
+}
+
+/// Adds a substep's impulses to the step totals.
+pub(crate) fn end_substep_one(cc: &mut ContactConstraint) {
+    for cp in &mut cc.points[..cc.count] {
+        cp.total_normal_impulse += cp.normal_impulse;
+        cp.total_tangent_impulse += cp.tangent_impulse;
     }
 }

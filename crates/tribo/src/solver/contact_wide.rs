@@ -23,8 +23,9 @@
 //! A lane computes the same expressions as the scalar code in the same order of
 //! operations, so a contact solved wide or scalar gets the same numbers.
 
-use super::contact_solver::ContactConstraint;
+use super::contact_solver::{ConstraintPoint, ContactConstraint};
 use super::wide::{F4, LANES, M4, V4};
+use super::Softness;
 use super::{BodyState, StepContext};
 use crate::math::Vec2;
 
@@ -32,7 +33,7 @@ use crate::math::Vec2;
 pub(crate) const COLORS: usize = 24;
 /// Colours open to constraints between two moving bodies (the rest, counted from the top,
 /// are for constraints with a static or kinematic side).
-const DYNAMIC_COLORS: usize = 20;
+pub(crate) const DYNAMIC_COLORS: usize = 20;
 
 /// One point of four constraints.
 #[derive(Clone, Copy, Debug, Default)]
@@ -97,6 +98,24 @@ pub(crate) struct WideContact {
     /// Share of the row's friction impulse each point reports (½, ½ or 1, 0).
     pub tangent_share: [F4; 2],
     pub any_rolling: bool,
+}
+
+/// The parts of four constraints the substeps do not touch (kept apart so the hot
+/// [`WideContact`]s stay small): what the scalar code needs to rebuild a lane.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct WideCold {
+    pub contact: [u32; LANES],
+    /// Manifold points of each lane (0 for an empty lane).
+    pub count: [u8; LANES],
+    pub restitution: [f32; LANES],
+    pub restitution_threshold: [f32; LANES],
+    pub kinetic_energy: [f32; LANES],
+    pub height: [f32; LANES],
+    pub base_drift: [[f32; LANES]; 2],
+    pub stick: [[bool; LANES]; 2],
+    pub fresh: [[bool; LANES]; 2],
+    /// Some lane has restitution.
+    pub any_restitution: bool,
 }
 
 /// Four bodies' velocities and step motion, gathered from [`BodyState`]s.
@@ -256,28 +275,36 @@ pub(crate) fn solve<const USE_BIAS: bool>(
     let xa0 = soft0(-(c.i11 * rhs0 + c.i12 * rhs1));
     let xa1 = soft1(-(c.i12 * rhs0 + c.i22 * rhs1));
     let ok_a = xa0.ge(zero) & xa1.ge(zero);
-    let r0 = rhs0 - c.k12 * lam1;
-    let xb0 = soft0(-(r0 * c.inv_k11));
-    let wb1 = rhs1 + c.k12 * (xb0 - lam0) - c.k22 * lam1;
-    let ok_b = xb0.ge(zero) & wb1.ge(zero);
-    let r1 = rhs1 - c.k12 * lam0;
-    let xc1 = soft1(-(r1 * c.inv_k22));
-    let wc0 = rhs0 + c.k12 * (xc1 - lam1) - c.k11 * lam0;
-    let ok_c = xc1.ge(zero) & wc0.ge(zero);
-    let wd0 = rhs0 - c.k11 * lam0 - c.k12 * lam1;
-    let wd1 = rhs1 - c.k12 * lam0 - c.k22 * lam1;
-    let ok_d = wd0.ge(zero) & wd1.ge(zero);
-    let block0 = ok_a.select(xa0, ok_b.select(xb0, zero));
-    let block1 = ok_a.select(xa1, (!ok_b & ok_c).select(xc1, zero));
-    let found = c.block & (ok_a | ok_b | ok_c | ok_d);
-    // Sequential rows where the block solve does not apply.
-    let seq0 = (lam0 + (-(p0.normal_mass * ms[0] * rhs0) - is[0] * (lam0 - pre0))).max(zero);
-    let new0 = found.select(block0, seq0);
-    apply(c, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(new0 - lam0));
-    let vn1 = relative_velocity(&a, &b, arms[1].0, arms[1].1).dot(n);
-    let seq1 = (lam1 + (-(p1.normal_mass * ms[1] * (vn1 + bias[1])) - is[1] * (lam1 - pre1))).max(zero);
-    let new1 = found.select(block1, seq1);
-    apply(c, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(new1 - lam1));
+    let (new0, new1) = if (ok_a & c.block).all() {
+        // Common case (a resting face): both points active in every lane.
+        apply(c, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(xa0 - lam0));
+        apply(c, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(xa1 - lam1));
+        (xa0, xa1)
+    } else {
+        let r0 = rhs0 - c.k12 * lam1;
+        let xb0 = soft0(-(r0 * c.inv_k11));
+        let wb1 = rhs1 + c.k12 * (xb0 - lam0) - c.k22 * lam1;
+        let ok_b = xb0.ge(zero) & wb1.ge(zero);
+        let r1 = rhs1 - c.k12 * lam0;
+        let xc1 = soft1(-(r1 * c.inv_k22));
+        let wc0 = rhs0 + c.k12 * (xc1 - lam1) - c.k11 * lam0;
+        let ok_c = xc1.ge(zero) & wc0.ge(zero);
+        let wd0 = rhs0 - c.k11 * lam0 - c.k12 * lam1;
+        let wd1 = rhs1 - c.k12 * lam0 - c.k22 * lam1;
+        let ok_d = wd0.ge(zero) & wd1.ge(zero);
+        let block0 = ok_a.select(xa0, ok_b.select(xb0, zero));
+        let block1 = ok_a.select(xa1, (!ok_b & ok_c).select(xc1, zero));
+        let found = c.block & (ok_a | ok_b | ok_c | ok_d);
+        // Sequential rows where the block solve does not apply.
+        let seq0 = (lam0 + (-(p0.normal_mass * ms[0] * rhs0) - is[0] * (lam0 - pre0))).max(zero);
+        let new0 = found.select(block0, seq0);
+        apply(c, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(new0 - lam0));
+        let vn1 = relative_velocity(&a, &b, arms[1].0, arms[1].1).dot(n);
+        let seq1 = (lam1 + (-(p1.normal_mass * ms[1] * (vn1 + bias[1])) - is[1] * (lam1 - pre1))).max(zero);
+        let new1 = found.select(block1, seq1);
+        apply(c, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(new1 - lam1));
+        (new0, new1)
+    };
     for (p, new) in c.points.iter_mut().zip([new0, new1]) {
         p.normal_impulse = new;
         p.max_normal_impulse = p.max_normal_impulse.max(new);
@@ -331,47 +358,28 @@ pub(crate) fn end_substep(c: &mut WideContact) {
     c.total_tangent_impulse += c.tangent_impulse;
 }
 
-/// Where a scalar constraint lives during the substeps.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Slot {
-    /// Lane `lane` of wide constraint `group`.
-    Wide { group: u32, lane: u8 },
-    /// Solved by the scalar code (no free colour).
-    Overflow,
-}
-
-/// Colours of one step: for each constraint (in the scalar list's order) its colour, or
-/// `None` for overflow. `moving[i]` tells whether state `i` is a dynamic body.
-pub(crate) fn color_constraints(
-    constraints: &[ContactConstraint],
-    moving: impl Fn(u32) -> bool,
-    body_count: usize,
-    out: &mut Vec<Option<u8>>,
-) {
-    let mut used = vec![0u32; body_count];
-    out.clear();
-    for cc in constraints {
-        let (ma, mb) = (moving(cc.index_a), moving(cc.index_b));
-        let busy = (if ma { used[cc.index_a as usize] } else { 0 }) | (if mb { used[cc.index_b as usize] } else { 0 });
-        let color = if ma && mb {
-            (0..DYNAMIC_COLORS).find(|&k| busy & (1 << k) == 0)
-        } else {
-            (1..COLORS).rev().find(|&k| busy & (1 << k) == 0)
-        };
-        if let Some(k) = color {
-            if ma {
-                used[cc.index_a as usize] |= 1 << k;
-            }
-            if mb {
-                used[cc.index_b as usize] |= 1 << k;
-            }
-        }
-        out.push(color.map(|k| k as u8));
-    }
-}
-
 /// Copies a scalar constraint into lane `l` (everything: geometry, masses, state).
-pub(crate) fn pack(w: &mut WideContact, l: usize, cc: &ContactConstraint, dynamic_a: bool, dynamic_b: bool) {
+pub(crate) fn pack(
+    w: &mut WideContact,
+    cold: &mut WideCold,
+    l: usize,
+    cc: &ContactConstraint,
+    dynamic_a: bool,
+    dynamic_b: bool,
+) {
+    cold.contact[l] = cc.contact;
+    cold.count[l] = cc.count as u8;
+    cold.restitution[l] = cc.restitution;
+    cold.restitution_threshold[l] = cc.restitution_threshold;
+    cold.kinetic_energy[l] = cc.kinetic_energy;
+    cold.height[l] = cc.height;
+    cold.any_restitution |= cc.restitution > 0.0;
+    for i in 0..2 {
+        let real = i < cc.count;
+        cold.base_drift[i][l] = if real { cc.points[i].base_drift } else { 0.0 };
+        cold.stick[i][l] = real && cc.points[i].stick;
+        cold.fresh[i][l] = real && cc.points[i].fresh;
+    }
     w.index_a[l] = cc.index_a;
     w.index_b[l] = cc.index_b;
     w.write_a[l] = dynamic_a && cc.index_a != 0;
@@ -506,4 +514,91 @@ pub(crate) fn unpack_state(w: &WideContact, l: usize, cc: &mut ContactConstraint
         cp.saturated = saturated;
     }
     cc.rolling_impulse = w.rolling_impulse.0[l];
+}
+
+/// Rebuilds the scalar constraint of lane `l` (geometry, masses and current state).
+pub(crate) fn unpack_full(w: &WideContact, cold: &WideCold, l: usize) -> ContactConstraint {
+    let count = cold.count[l] as usize;
+    let block = w.block.lane(l);
+    let soft = Softness {
+        bias_rate: w.bias_rate.0[l],
+        mass_scale: w.mass_scale.0[l],
+        impulse_scale: w.impulse_scale.0[l],
+    };
+    let mut cc = ContactConstraint {
+        index_a: w.index_a[l],
+        index_b: w.index_b[l],
+        contact: cold.contact[l],
+        normal: Vec2::new(w.normal.x.0[l], w.normal.y.0[l]),
+        inv_mass_a: w.inv_mass_a.0[l],
+        inv_i_a: w.inv_i_a.0[l],
+        inv_mass_b: w.inv_mass_b.0[l],
+        inv_i_b: w.inv_i_b.0[l],
+        mu_s: w.mu_s.0[l],
+        mu_d: w.mu_d.0[l],
+        restitution: cold.restitution[l],
+        restitution_threshold: cold.restitution_threshold[l],
+        rolling_resistance: w.rolling_resistance.0[l],
+        rolling_mass: w.rolling_mass.0[l],
+        rolling_impulse: 0.0,
+        tangent_speed: w.tangent_speed.0[l],
+        k: if block {
+            [w.k11.0[l], w.k12.0[l], w.k22.0[l]]
+        } else {
+            [0.0; 3]
+        },
+        inv_k: if block {
+            [w.i11.0[l], w.i12.0[l], w.i22.0[l]]
+        } else {
+            [0.0; 3]
+        },
+        block,
+        split: w.split.0[l],
+        kinetic_energy: cold.kinetic_energy[l],
+        height: cold.height[l],
+        patch_tangent_mass: if count == 2 { w.tangent_mass.0[l] } else { 0.0 },
+        count,
+        points: [ConstraintPoint::default(); 2],
+    };
+    for i in 0..count {
+        let wp = &w.points[i];
+        let cp = &mut cc.points[i];
+        cp.r_a = Vec2::new(wp.r_a.x.0[l], wp.r_a.y.0[l]);
+        cp.r_b = Vec2::new(wp.r_b.x.0[l], wp.r_b.y.0[l]);
+        cp.base_separation = wp.base_separation.0[l];
+        cp.base_drift = cold.base_drift[i][l];
+        cp.normal_mass = wp.normal_mass.0[l];
+        cp.tangent_mass = if count == 1 { w.tangent_mass.0[l] } else { 0.0 };
+        cp.preload = wp.preload.0[l];
+        cp.soft = soft;
+        cp.stick = cold.stick[i][l];
+        cp.fresh = cold.fresh[i][l];
+    }
+    unpack_state(w, l, &mut cc);
+    cc
+}
+
+/// Rebuilds only what storing impulses reads of lane `l` (see
+/// `contact_solver::store_impulses`): bodies, normal, friction data, anchors and state.
+pub(crate) fn unpack_for_store(w: &WideContact, cold: &WideCold, l: usize, cc: &mut ContactConstraint) {
+    let count = cold.count[l] as usize;
+    cc.index_a = w.index_a[l];
+    cc.index_b = w.index_b[l];
+    cc.contact = cold.contact[l];
+    cc.normal = Vec2::new(w.normal.x.0[l], w.normal.y.0[l]);
+    cc.mu_s = w.mu_s.0[l];
+    cc.tangent_speed = w.tangent_speed.0[l];
+    cc.split = w.split.0[l];
+    cc.count = count;
+    for i in 0..count {
+        let wp = &w.points[i];
+        let cp = &mut cc.points[i];
+        cp.r_a = Vec2::new(wp.r_a.x.0[l], wp.r_a.y.0[l]);
+        cp.r_b = Vec2::new(wp.r_b.x.0[l], wp.r_b.y.0[l]);
+        cp.base_drift = cold.base_drift[i][l];
+        cp.preload = wp.preload.0[l];
+        cp.stick = cold.stick[i][l];
+        cp.fresh = cold.fresh[i][l];
+    }
+    unpack_state(w, l, cc);
 }

@@ -3,7 +3,9 @@
 //!
 //! Pipeline stage: after the narrow phase, before finalize. The stage order of one step:
 //!
-//! 1. prepare constraints (anchors, effective masses, softness, warm-start impulses)
+//! 1. prepare constraints (anchors, effective masses, softness, warm-start impulses, graph
+//!    colouring; built by the world from the touching contacts, see [`contact_set`]);
+//!    estimate the impulses of new resting contacts
 //! 2. for each of the `substeps` substeps of length `h = dt / substeps`:
 //!    1. integrate velocities (gravity, forces, damping)
 //!    2. warm start (re-apply the accumulated impulses)
@@ -16,6 +18,7 @@
 //! Constraints join the solver through [`ConstraintSet`]; contacts are the one set today,
 //! joints will be another.
 
+pub(crate) mod contact_set;
 pub(crate) mod contact_solver;
 pub(crate) mod contact_wide;
 pub(crate) mod softness;
@@ -73,27 +76,21 @@ pub(crate) struct StepContext {
     pub warm_starting: bool,
 }
 
-/// A family of constraints solved by the step (contacts now; joints later).
+/// A family of constraints solved by the step (contacts now; joints later). The set is
+/// built before the step's stages run.
 pub(crate) trait ConstraintSet {
-    /// Computes anchors, masses and softness; loads warm-start impulses.
-    fn prepare(&mut self, ctx: &StepContext, states: &[BodyState]);
     /// Whether any constraint has points new this step.
     fn has_new_contacts(&self) -> bool;
-    /// Records each point's normal velocity in `states` (before any impulse).
-    fn record_approach(&mut self, states: &[BodyState]);
-    /// Re-applies the accumulated impulses at the start of a substep.
-    fn warm_start(&mut self, states: &mut [BodyState]);
-    /// One sequential-impulse pass; `use_bias` adds the soft position correction.
-    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, elapsed: f32);
-    /// Arranges the constraints for the substeps (colouring, wide packing) once the
-    /// warm-start impulses are final; `body_count` is the number of solver states.
-    fn begin_substeps(&mut self, body_count: usize);
-    /// Accumulates what a substep applied (after its relax pass).
-    fn end_substep(&mut self);
     /// Estimates warm-start impulses for constraints that begin at rest (no history):
     /// rigid iterations against `trial`, the states after one substep of forces. Returns
     /// whether any constraint was estimated. The trial velocities are thrown away.
     fn estimate_new_contacts(&mut self, ctx: &StepContext, trial: &mut [BodyState]) -> bool;
+    /// Re-applies the accumulated impulses at the start of a substep.
+    fn warm_start(&mut self, states: &mut [BodyState]);
+    /// One sequential-impulse pass; `use_bias` adds the soft position correction.
+    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, elapsed: f32);
+    /// Accumulates what a substep applied (after its relax pass).
+    fn end_substep(&mut self);
     /// Restitution pass after all substeps.
     fn restitution(&mut self, states: &mut [BodyState]);
 }
@@ -108,17 +105,14 @@ pub(crate) fn solve_step<C: ConstraintSet>(
     profile: &mut Profile,
 ) {
     let mut lap = Stopwatch::start();
-    constraints.prepare(ctx, states);
     // A contact that begins at rest has no warm start: its first substeps would let the
     // body sag and slide before the load builds up (the settling creep of Box2D and
     // Rapier). Estimate its impulses first on a scratch copy of the states.
     if constraints.has_new_contacts() {
         let mut trial = states.to_vec();
         integrate_velocities(ctx, sims, &mut trial);
-        constraints.record_approach(&trial);
         constraints.estimate_new_contacts(ctx, &mut trial);
     }
-    constraints.begin_substeps(states.len());
     profile.prepare = lap.lap();
     let mut t = [0.0f32; 5];
     for i in 0..ctx.substeps {

@@ -94,6 +94,12 @@ impl M4 {
         self.0[i] != 0
     }
 
+    /// Whether every lane is true.
+    #[inline(always)]
+    pub fn all(self) -> bool {
+        (self.0[0] & self.0[1] & self.0[2] & self.0[3]) == u32::MAX
+    }
+
     /// `self ? a : b` lane by lane.
     #[inline(always)]
     pub fn select(self, a: F4, b: F4) -> F4 {
@@ -252,5 +258,6 @@ mod tests {
         assert_eq!(m.select(a, b).0, [1.5, 4.0, -0.0, 3.25]);
         assert_eq!(m.to_unit().0, [1.0, 0.0, 0.0, 1.0]);
         assert_eq!((!m & a.ge(b)).0, [0, 0, u32::MAX, 0]);
+        assert!(!m.all() && (m | !m).all());
     }
 }

@@ -26,7 +26,7 @@ use crate::dynamics::{BodyDef, BodyType, Filter, Material, ShapeDef};
 use crate::error::{check_finite, check_non_negative, check_positive, check_vec, Error, Result};
 use crate::geometry::{Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Aabb, Transform, Vec2};
-use crate::solver::contact_solver::ContactSolver;
+use crate::solver::contact_set::{Candidate, ContactSolver};
 use crate::solver::{BodySim, BodyState};
 
 /// World settings. Every field has a default (listed on the field) that matches Box2D v3
@@ -111,6 +111,7 @@ pub struct World {
     pub(crate) states: Vec<BodyState>,
     pub(crate) sims: Vec<BodySim>,
     pub(crate) contact_solver: ContactSolver,
+    pub(crate) candidates: Vec<Candidate>,
     pub(crate) scratch_u32: Vec<u32>,
     pub(crate) scratch_f32: Vec<f32>,
     pub(crate) step_count: u64,
@@ -135,6 +136,7 @@ impl World {
             states: Vec::new(),
             sims: Vec::new(),
             contact_solver: ContactSolver::default(),
+            candidates: Vec::new(),
             scratch_u32: Vec::new(),
             scratch_f32: Vec::new(),
             step_count: 0,

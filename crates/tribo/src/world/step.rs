@@ -13,6 +13,7 @@ use crate::dynamics::{mix, BodyType};
 use crate::error::{Error, Result};
 use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
+use crate::solver::contact_set::Candidate;
 use crate::solver::contact_solver::{store_impulses, ConstraintBodies};
 use crate::solver::{solve_step, BodySim, BodyState, StepContext};
 use crate::world::BodyId;
@@ -159,6 +160,7 @@ impl World {
             rolling_radius: rolling_radius(&a.geometry).max(rolling_radius(&b.geometry)),
             rolling_impulse: 0.0,
             touching: false,
+            basis: Default::default(),
         };
         let (body_a, body_b) = (contact.body_a, contact.body_b);
         let ci = match self.contact_free.pop() {
@@ -209,7 +211,8 @@ impl World {
             let rel = (bb.v - ba.v).length() + ba.w.abs() * ba.max_extent + bb.w.abs() * bb.max_extent;
             let margin = SPECULATIVE_DISTANCE + dt * rel;
             let was = c.touching;
-            let now = c.update(&sa.geometry, ba.xf, &sb.geometry, bb.xf, margin);
+            let now = c.recycle(ba.xf, bb.xf, ba.max_extent + bb.max_extent)
+                || c.update(&sa.geometry, ba.xf, &sb.geometry, bb.xf, margin);
             if now && !was {
                 self.events.begin.push(ContactBeginEvent {
                     shape_a: c.shape_a,
@@ -279,9 +282,8 @@ impl World {
         }
         // Constraints: contacts between two moving bodies first, then contacts with static
         // bodies, so the ground has the last word in each pass (as Box2D's colouring does).
-        let mut solver = core::mem::take(&mut self.contact_solver);
-        solver.constraints.clear();
-        solver.up = (-g).normalize_or_zero();
+        let mut candidates = core::mem::take(&mut self.candidates);
+        candidates.clear();
         for pass_static in [false, true] {
             for (ci, slot) in self.contacts.iter().enumerate() {
                 let Some(c) = slot else { continue };
@@ -299,27 +301,34 @@ impl World {
                 if has_static != pass_static {
                     continue;
                 }
-                let bodies = ConstraintBodies {
-                    index_a: ba.solver_index,
-                    index_b: bb.solver_index,
-                    inv_mass_a: if ba.solver_index == 0 { 0.0 } else { ba.inv_mass },
-                    inv_i_a: if ba.solver_index == 0 { 0.0 } else { ba.inv_inertia },
-                    inv_mass_b: if bb.solver_index == 0 { 0.0 } else { bb.inv_mass },
-                    inv_i_b: if bb.solver_index == 0 { 0.0 } else { bb.inv_inertia },
-                    center_a: ba.center,
-                    center_b: bb.center,
-                };
-                solver.push(ci as u32, c, &bodies);
+                candidates.push(Candidate {
+                    contact: ci as u32,
+                    bodies: ConstraintBodies {
+                        index_a: ba.solver_index,
+                        index_b: bb.solver_index,
+                        inv_mass_a: if ba.solver_index == 0 { 0.0 } else { ba.inv_mass },
+                        inv_i_a: if ba.solver_index == 0 { 0.0 } else { ba.inv_inertia },
+                        inv_mass_b: if bb.solver_index == 0 { 0.0 } else { bb.inv_mass },
+                        inv_i_b: if bb.solver_index == 0 { 0.0 } else { bb.inv_inertia },
+                        center_a: ba.center,
+                        center_b: bb.center,
+                    },
+                });
             }
         }
+        let mut solver = core::mem::take(&mut self.contact_solver);
+        solver.up = (-g).normalize_or_zero();
+        solver.build(ctx, &self.states, &candidates, &self.contacts);
+        self.candidates = candidates;
         self.profile.solver_setup = lap.lap();
         solve_step(ctx, &self.sims, &mut self.states, &mut solver, &mut self.profile);
         lap.lap();
-        for cc in &solver.constraints {
-            if let Some(Some(c)) = self.contacts.get_mut(cc.contact as usize) {
-                store_impulses(cc, c, &self.states, ctx);
+        let (contacts, states) = (&mut self.contacts, &self.states);
+        solver.for_each_to_store(|cc| {
+            if let Some(Some(c)) = contacts.get_mut(cc.contact as usize) {
+                store_impulses(cc, c, states, ctx);
             }
-        }
+        });
         self.contact_solver = solver;
         self.profile.store = lap.lap();
     }

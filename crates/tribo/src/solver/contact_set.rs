@@ -1,0 +1,368 @@
+//! The contact constraints of one step, arranged for the solver stages: graph colouring,
+//! wide packing, overflow, mass-ratio groups, and the [`ConstraintSet`] stages over them.
+//!
+//! Build (once per step, from the touching contacts in solve order: pairs of moving
+//! bodies first, then pairs with a static side):
+//! 1. colour every constraint (greedy first fit on per-body colour masks: moving pairs take
+//!    the lowest free colour, pairs with a static or kinematic side the highest, so each
+//!    pass solves them last, as Box2D v3's `constraint_graph.c` does); no free colour →
+//!    overflow;
+//! 2. lay the colours out as runs of [`WideContact`]s (four lanes each);
+//! 3. build each scalar constraint ([`build_constraint`]) and pack it into its lane, or keep
+//!    it whole in the overflow list.
+//!
+//! The physics of a lane and of a scalar constraint are the same ([`contact_wide`] docs);
+//! the scalar code still runs wherever it is simpler: overflow, the warm-start estimate of
+//! new contacts, the extra sweeps of light bodies under heavy ones, restitution, and
+//! storing impulses back into the contacts (each rebuilds a lane with
+//! [`contact_wide::unpack_full`] and writes its state back).
+
+use super::contact_solver::{
+    build_constraint, end_substep_one, estimate, has_fresh_point, is_new_resting, record_approach, restitution_one,
+    solve_one, warm_start_one, ConstraintBodies, ContactConstraint, StepSoftness, MASS_RATIO_GROUP, MAX_LOCAL_SWEEPS,
+};
+use super::contact_wide::{self, WideCold, WideContact, COLORS, DYNAMIC_COLORS};
+use super::wide::LANES;
+use super::{BodyState, ConstraintSet, StepContext};
+use crate::collision::contact::Contact;
+use crate::math::Vec2;
+
+/// Where a constraint lives during the substeps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Slot {
+    /// Lane `lane` of `wide[group]`.
+    Wide { group: u32, lane: u8 },
+    /// `overflow[index]`.
+    Overflow(u32),
+}
+
+/// One touching contact to solve this step.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Candidate {
+    pub contact: u32,
+    pub bodies: ConstraintBodies,
+}
+
+/// A light body's constraints, solved again ⌈M/m⌉ times per relax pass.
+struct Group {
+    members: Vec<(Slot, ContactConstraint)>,
+    sweeps: u32,
+}
+
+/// All contact constraints of a step (see the module docs).
+#[derive(Default)]
+pub(crate) struct ContactSolver {
+    /// Unit vector against gravity (zero without gravity).
+    pub up: Vec2,
+    wide: Vec<WideContact>,
+    cold: Vec<WideCold>,
+    /// Constraints that found no colour, whole (solved first in each pass).
+    overflow: Vec<ContactConstraint>,
+    /// Constraints with a point new this step.
+    fresh: Vec<Slot>,
+    groups: Vec<Group>,
+    // Scratch reused every step.
+    colours: Vec<u8>,
+    used: Vec<u32>,
+    slots: Vec<Slot>,
+}
+
+/// No colour: the constraint goes to the overflow list.
+const OVERFLOW: u8 = u8::MAX;
+
+/// Whether a constraint side is a dynamic body (moves under impulses).
+#[inline]
+fn dynamic_side(inv_mass: f32, inv_i: f32) -> bool {
+    inv_mass > 0.0 || inv_i > 0.0
+}
+
+impl ContactSolver {
+    /// Builds the step's constraints from `candidates` (in solve order); `contacts` is the
+    /// world's contact list, `states` the awake bodies' solver states.
+    pub fn build(
+        &mut self,
+        ctx: &StepContext,
+        states: &[BodyState],
+        candidates: &[Candidate],
+        contacts: &[Option<Contact>],
+    ) {
+        self.overflow.clear();
+        self.fresh.clear();
+        self.groups.clear();
+        // 1. Colours.
+        self.used.clear();
+        self.used.resize(states.len(), 0);
+        self.colours.clear();
+        let mut counts = [0u32; COLORS];
+        for cand in candidates {
+            let b = &cand.bodies;
+            let (da, db) = (
+                b.index_a != 0 && dynamic_side(b.inv_mass_a, b.inv_i_a),
+                b.index_b != 0 && dynamic_side(b.inv_mass_b, b.inv_i_b),
+            );
+            let busy = (if da { self.used[b.index_a as usize] } else { 0 })
+                | (if db { self.used[b.index_b as usize] } else { 0 });
+            let free = |k: &usize| busy & (1 << *k) == 0;
+            let colour = if da && db {
+                (0..DYNAMIC_COLORS).find(free)
+            } else {
+                (1..COLORS).rev().find(free)
+            };
+            match colour {
+                Some(k) => {
+                    if da {
+                        self.used[b.index_a as usize] |= 1 << k;
+                    }
+                    if db {
+                        self.used[b.index_b as usize] |= 1 << k;
+                    }
+                    counts[k] += 1;
+                    self.colours.push(k as u8);
+                }
+                None => self.colours.push(OVERFLOW),
+            }
+        }
+        // 2. Layout: colour k fills lanes from `next[k]` on (in lanes, not groups).
+        let mut next = [0u32; COLORS];
+        let mut groups = 0u32;
+        for k in 0..COLORS {
+            next[k] = groups * LANES as u32;
+            groups += counts[k].div_ceil(LANES as u32);
+        }
+        self.wide.clear();
+        self.wide.resize(groups as usize, WideContact::default());
+        self.cold.clear();
+        self.cold.resize(groups as usize, WideCold::default());
+        // 3. Build and pack.
+        let soft = StepSoftness::new(ctx);
+        self.slots.clear();
+        let mut light: Vec<(u32, u32)> = Vec::new(); // (light body state, sweeps)
+        for (cand, &colour) in candidates.iter().zip(&self.colours) {
+            let Some(Some(c)) = contacts.get(cand.contact as usize) else {
+                // Cannot happen (candidates come from the contact list); keep the lane empty.
+                self.slots.push(Slot::Overflow(u32::MAX));
+                continue;
+            };
+            let cc = build_constraint(cand.contact, c, &cand.bodies, self.up, &soft, ctx, states);
+            if cc.inv_mass_a > 0.0 && cc.inv_mass_b > 0.0 {
+                let (ratio, body) = if cc.inv_mass_a > cc.inv_mass_b {
+                    (cc.inv_mass_a / cc.inv_mass_b, cc.index_a)
+                } else {
+                    (cc.inv_mass_b / cc.inv_mass_a, cc.index_b)
+                };
+                if ratio > MASS_RATIO_GROUP {
+                    light.push((body, (ratio.ceil() as u32).min(MAX_LOCAL_SWEEPS)));
+                }
+            }
+            let slot = if colour == OVERFLOW {
+                self.overflow.push(cc);
+                Slot::Overflow(self.overflow.len() as u32 - 1)
+            } else {
+                let at = next[colour as usize];
+                next[colour as usize] += 1;
+                let (group, lane) = (at / LANES as u32, at % LANES as u32);
+                let b = &cand.bodies;
+                let da = dynamic_side(b.inv_mass_a, b.inv_i_a);
+                let db = dynamic_side(b.inv_mass_b, b.inv_i_b);
+                let (w, cold) = (&mut self.wide[group as usize], &mut self.cold[group as usize]);
+                contact_wide::pack(w, cold, lane as usize, &cc, da, db);
+                Slot::Wide {
+                    group,
+                    lane: lane as u8,
+                }
+            };
+            if has_fresh_point(&cc) {
+                self.fresh.push(slot);
+            }
+            self.slots.push(slot);
+        }
+        self.build_groups(light, candidates);
+    }
+
+    /// Mass-ratio groups: each light body touching a moving body more than
+    /// [`MASS_RATIO_GROUP`]× heavier gets its constraints swept ⌈M/m⌉ (at most
+    /// [`MAX_LOCAL_SWEEPS`]) extra times per relax pass. Sequential impulses move momentum
+    /// through a light body between a heavy one and the ground only at a rate of about m/M
+    /// per sweep, so a 100:1 stack needs ~100 sweeps where one is enough for equal masses.
+    fn build_groups(&mut self, mut light: Vec<(u32, u32)>, candidates: &[Candidate]) {
+        if light.is_empty() {
+            return;
+        }
+        light.sort_unstable();
+        light.dedup_by(|x, y| {
+            if x.0 == y.0 {
+                y.1 = y.1.max(x.1);
+                true
+            } else {
+                false
+            }
+        });
+        for &(body, sweeps) in &light {
+            let mut members = Vec::new();
+            for (cand, &slot) in candidates.iter().zip(&self.slots) {
+                if cand.bodies.index_a == body || cand.bodies.index_b == body {
+                    members.push((slot, self.get(slot)));
+                }
+            }
+            self.groups.push(Group { members, sweeps });
+        }
+    }
+
+    /// The scalar constraint at a slot, with its current state.
+    fn get(&self, slot: Slot) -> ContactConstraint {
+        match slot {
+            Slot::Wide { group, lane } => {
+                let g = group as usize;
+                contact_wide::unpack_full(&self.wide[g], &self.cold[g], lane as usize)
+            }
+            Slot::Overflow(i) => self.overflow[i as usize],
+        }
+    }
+
+    /// Writes a scalar constraint's state back to its slot (`full`: geometry and preload
+    /// too, after the estimate).
+    fn put(&mut self, slot: Slot, cc: &ContactConstraint, full: bool) {
+        match slot {
+            Slot::Wide { group, lane } => {
+                let g = group as usize;
+                let w = &mut self.wide[g];
+                if full {
+                    let (da, db) = (w.write_a[lane as usize], w.write_b[lane as usize]);
+                    contact_wide::pack(w, &mut self.cold[g], lane as usize, cc, da, db);
+                } else {
+                    contact_wide::pack_state(w, lane as usize, cc);
+                }
+            }
+            Slot::Overflow(i) => self.overflow[i as usize] = *cc,
+        }
+    }
+
+    /// Calls `f` with every constraint of the step in its final state (for storing
+    /// impulses: wide lanes carry only what `store_impulses` reads).
+    pub fn for_each_to_store(&self, mut f: impl FnMut(&ContactConstraint)) {
+        for cc in &self.overflow {
+            f(cc);
+        }
+        let Some(first) = self.wide.first() else {
+            return;
+        };
+        // A template whose unread fields stay as they are for every lane.
+        let mut cc = contact_wide::unpack_full(first, &self.cold[0], 0);
+        for (w, cold) in self.wide.iter().zip(&self.cold) {
+            for l in 0..LANES {
+                if cold.count[l] > 0 {
+                    contact_wide::unpack_for_store(w, cold, l, &mut cc);
+                    f(&cc);
+                }
+            }
+        }
+    }
+}
+
+impl ConstraintSet for ContactSolver {
+    fn has_new_contacts(&self) -> bool {
+        !self.fresh.is_empty()
+    }
+
+    fn estimate_new_contacts(&mut self, ctx: &StepContext, trial: &mut [BodyState]) -> bool {
+        let mut subset = Vec::new();
+        let mut slots = Vec::new();
+        for &slot in &self.fresh {
+            let mut cc = self.get(slot);
+            record_approach(&mut cc, trial);
+            if is_new_resting(&cc) {
+                subset.push(cc);
+                slots.push(slot);
+            }
+        }
+        if subset.is_empty() {
+            return false;
+        }
+        estimate(&mut subset, self.up, ctx, trial);
+        // `estimate` sorted the subset: find each constraint's slot by its contact.
+        let mut by_contact: Vec<(u32, Slot)> = slots.iter().map(|&s| (self.get(s).contact, s)).collect();
+        by_contact.sort_unstable_by_key(|x| x.0);
+        for cc in &subset {
+            if let Ok(k) = by_contact.binary_search_by_key(&cc.contact, |x| x.0) {
+                self.put(by_contact[k].1, cc, true);
+            }
+        }
+        true
+    }
+
+    fn warm_start(&mut self, states: &mut [BodyState]) {
+        for cc in &mut self.overflow {
+            warm_start_one(cc, states);
+        }
+        for w in &mut self.wide {
+            contact_wide::warm_start(w, states);
+        }
+    }
+
+    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, elapsed: f32) {
+        for cc in &mut self.overflow {
+            solve_one(cc, states, ctx, use_bias, elapsed);
+        }
+        for w in &mut self.wide {
+            if use_bias {
+                contact_wide::solve::<true>(w, states, ctx, elapsed);
+            } else {
+                contact_wide::solve::<false>(w, states, ctx, elapsed);
+            }
+        }
+        // Extra local sweeps where a light body carries a heavy one, in the relax pass only:
+        // the soft rows of the biased pass are formulated for exactly one sweep (each
+        // sweep relaxes the impulse towards its preload).
+        if use_bias {
+            return;
+        }
+        let mut groups = core::mem::take(&mut self.groups);
+        for g in &mut groups {
+            for _ in 0..g.sweeps {
+                for (slot, cc) in g.members.iter_mut() {
+                    self.sync_from(*slot, cc);
+                    solve_one(cc, states, ctx, use_bias, elapsed);
+                    self.put(*slot, cc, false);
+                }
+            }
+        }
+        self.groups = groups;
+    }
+
+    fn end_substep(&mut self) {
+        for cc in &mut self.overflow {
+            end_substep_one(cc);
+        }
+        for w in &mut self.wide {
+            contact_wide::end_substep(w);
+        }
+    }
+
+    fn restitution(&mut self, states: &mut [BodyState]) {
+        for cc in &mut self.overflow {
+            restitution_one(cc, states);
+        }
+        for g in 0..self.wide.len() {
+            if !self.cold[g].any_restitution {
+                continue;
+            }
+            for l in 0..LANES {
+                if self.cold[g].count[l] > 0 && self.cold[g].restitution[l] > 0.0 {
+                    let mut cc = contact_wide::unpack_full(&self.wide[g], &self.cold[g], l);
+                    restitution_one(&mut cc, states);
+                    contact_wide::pack_state(&mut self.wide[g], l, &cc);
+                }
+            }
+        }
+    }
+}
+
+impl ContactSolver {
+    /// Refreshes a copy's state from its slot (the coloured passes changed it).
+    fn sync_from(&self, slot: Slot, cc: &mut ContactConstraint) {
+        match slot {
+            Slot::Wide { group, lane } => contact_wide::unpack_state(&self.wide[group as usize], lane as usize, cc),
+            Slot::Overflow(i) => *cc = self.overflow[i as usize],
+        }
+    }
+}
