@@ -129,10 +129,25 @@ impl ContactSolver {
             next[k] = groups * LANES as u32;
             groups += counts[k].div_ceil(LANES as u32);
         }
-        self.wide.clear();
+        // Every used lane is written whole by `pack`; only the block flags and the empty
+        // lanes at the end of each colour need clearing (no 1 KB-per-group memset).
         self.wide.resize(groups as usize, WideContact::default());
-        self.cold.clear();
         self.cold.resize(groups as usize, WideCold::default());
+        self.wide.truncate(groups as usize);
+        self.cold.truncate(groups as usize);
+        for (w, cold) in self.wide.iter_mut().zip(self.cold.iter_mut()) {
+            w.any_rolling = false;
+            cold.any_restitution = false;
+        }
+        for k in 0..COLORS {
+            let (end, lanes) = (next[k] + counts[k], LANES as u32);
+            if counts[k] % lanes != 0 {
+                let g = (end / lanes) as usize;
+                for l in (end % lanes) as usize..LANES {
+                    contact_wide::clear_lane(&mut self.wide[g], &mut self.cold[g], l);
+                }
+            }
+        }
         // 3. Build and pack.
         let soft = StepSoftness::new(ctx);
         self.slots.clear();
@@ -237,22 +252,29 @@ impl ContactSolver {
         }
     }
 
-    /// Calls `f` with every constraint of the step in its final state (for storing
-    /// impulses: wide lanes carry only what `store_impulses` reads).
+    /// Calls `f` with every constraint of the step in its final state, in build order
+    /// (contact order within each pass, so the contacts are written back in memory
+    /// order); wide lanes carry only what `store_impulses` reads.
     pub fn for_each_to_store(&self, mut f: impl FnMut(&ContactConstraint)) {
-        for cc in &self.overflow {
-            f(cc);
-        }
-        let Some(first) = self.wide.first() else {
-            return;
-        };
         // A template whose unread fields stay as they are for every lane.
-        let mut cc = contact_wide::unpack_full(first, &self.cold[0], 0);
-        for (w, cold) in self.wide.iter().zip(&self.cold) {
-            for l in 0..LANES {
-                if cold.count[l] > 0 {
-                    contact_wide::unpack_for_store(w, cold, l, &mut cc);
+        let mut cc = match self.wide.first() {
+            Some(w) => contact_wide::unpack_full(w, &self.cold[0], 0),
+            None => match self.overflow.first() {
+                Some(cc) => *cc,
+                None => return,
+            },
+        };
+        for &slot in &self.slots {
+            match slot {
+                Slot::Wide { group, lane } => {
+                    let g = group as usize;
+                    contact_wide::unpack_for_store(&self.wide[g], &self.cold[g], lane as usize, &mut cc);
                     f(&cc);
+                }
+                Slot::Overflow(i) => {
+                    if let Some(o) = self.overflow.get(i as usize) {
+                        f(o);
+                    }
                 }
             }
         }
@@ -321,7 +343,16 @@ impl ConstraintSet for ContactSolver {
             for _ in 0..g.sweeps {
                 for (slot, cc) in g.members.iter_mut() {
                     self.sync_from(*slot, cc);
+                    // The relax pass already added this substep's impulses to the totals;
+                    // add what the extra sweep changes.
+                    let before = cc.points.map(|p| (p.normal_impulse, p.tangent_impulse));
                     solve_one(cc, states, ctx, use_bias, elapsed);
+                    if let Slot::Wide { .. } = slot {
+                        for (p, (n, t)) in cc.points.iter_mut().zip(before) {
+                            p.total_normal_impulse += p.normal_impulse - n;
+                            p.total_tangent_impulse += p.tangent_impulse - t;
+                        }
+                    }
                     self.put(*slot, cc, false);
                 }
             }
@@ -330,11 +361,9 @@ impl ConstraintSet for ContactSolver {
     }
 
     fn end_substep(&mut self) {
+        // Wide lanes added their totals at the end of the relax pass.
         for cc in &mut self.overflow {
             end_substep_one(cc);
-        }
-        for w in &mut self.wide {
-            contact_wide::end_substep(w);
         }
     }
 

@@ -335,6 +335,10 @@ pub(crate) fn solve<const USE_BIAS: bool>(
     apply(c, &mut a, &mut b, r_a, r_b, t.scale(new - old));
     c.tangent_impulse = new;
     if !USE_BIAS {
+        // The relax pass ends the substep: add its impulses to the step totals.
+        c.points[0].total_normal_impulse += new0;
+        c.points[1].total_normal_impulse += new1;
+        c.total_tangent_impulse += new;
         c.saturated = limit.gt(zero) & unclamped.abs().gt(limit);
         if c.any_rolling {
             let rlimit = c.rolling_resistance * (new0 + new1);
@@ -350,12 +354,14 @@ pub(crate) fn solve<const USE_BIAS: bool>(
     scatter(states, &c.index_b, &c.write_b, &b);
 }
 
-/// Adds a substep's impulses to the step totals.
-pub(crate) fn end_substep(c: &mut WideContact) {
-    for p in &mut c.points {
-        p.total_normal_impulse += p.normal_impulse;
-    }
-    c.total_tangent_impulse += c.tangent_impulse;
+/// Empties lane `l` (static body on both sides, no mass, no impulse): it then changes
+/// nothing when solved.
+pub(crate) fn clear_lane(w: &mut WideContact, cold: &mut WideCold, l: usize) {
+    let empty = WideContact::default();
+    let empty_cold = WideCold::default();
+    let mut cc = unpack_full(&empty, &empty_cold, 0);
+    cc.count = 0;
+    pack(w, cold, l, &cc, false, false);
 }
 
 /// Copies a scalar constraint into lane `l` (everything: geometry, masses, state).

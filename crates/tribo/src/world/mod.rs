@@ -112,6 +112,10 @@ pub struct World {
     pub(crate) sims: Vec<BodySim>,
     pub(crate) contact_solver: ContactSolver,
     pub(crate) candidates: Vec<Candidate>,
+    /// Contacts with an awake moving body (narrow phase of the current step).
+    pub(crate) active_contacts: Vec<u32>,
+    /// The touching ones among them after the narrow phase (solver and islands).
+    pub(crate) touching_contacts: Vec<u32>,
     pub(crate) scratch_u32: Vec<u32>,
     pub(crate) scratch_f32: Vec<f32>,
     pub(crate) step_count: u64,
@@ -137,6 +141,8 @@ impl World {
             sims: Vec::new(),
             contact_solver: ContactSolver::default(),
             candidates: Vec::new(),
+            active_contacts: Vec::new(),
+            touching_contacts: Vec::new(),
             scratch_u32: Vec::new(),
             scratch_f32: Vec::new(),
             step_count: 0,

@@ -186,7 +186,12 @@ impl World {
     fn collide(&mut self, dt: f32) {
         let mut to_destroy = Vec::new();
         let mut to_wake = Vec::new();
-        for ci in 0..self.contacts.len() {
+        let mut active = core::mem::take(&mut self.active_contacts);
+        self.collect_active_contacts(&mut active, false);
+        let mut touching = core::mem::take(&mut self.touching_contacts);
+        touching.clear();
+        for &ci in &active {
+            let ci = ci as usize;
             let Some(c) = self.contacts[ci].as_mut() else { continue };
             let (Some(ba), Some(bb)) = (self.bodies.at(c.body_a), self.bodies.at(c.body_b)) else {
                 continue;
@@ -232,13 +237,64 @@ impl World {
                     shape_b: c.shape_b,
                 });
             }
+            if now {
+                touching.push(ci as u32);
+            }
         }
+        self.active_contacts = active;
+        self.touching_contacts = touching;
         for ci in to_destroy {
             self.destroy_contact(ci, false);
         }
-        for bi in to_wake {
-            self.wake_body(bi);
+        if !to_wake.is_empty() {
+            for bi in to_wake {
+                self.wake_body(bi);
+            }
+            // The woken islands' contacts join the solve with their last manifolds.
+            let mut touching = core::mem::take(&mut self.touching_contacts);
+            self.collect_active_contacts(&mut touching, true);
+            self.touching_contacts = touching;
         }
+    }
+
+    /// The contacts with an awake moving body (only touching ones if `touching_only`), in
+    /// contact order: found through the awake bodies' contact lists, so sleeping islands
+    /// cost nothing.
+    fn collect_active_contacts(&self, out: &mut Vec<u32>, touching_only: bool) {
+        out.clear();
+        let active = |bi: u32| {
+            self.bodies
+                .at(bi)
+                .is_some_and(|b| b.awake && b.body_type != BodyType::Static)
+        };
+        let awake = self.bodies.iter().filter(|(_, b)| b.awake && b.body_type != BodyType::Static).count();
+        if 2 * awake > self.bodies.len() {
+            // Mostly awake: one pass in memory order beats chasing the bodies' lists.
+            for (ci, c) in self.contacts.iter().enumerate() {
+                let Some(c) = c else { continue };
+                if (!touching_only || c.touching) && (active(c.body_a) || active(c.body_b)) {
+                    out.push(ci as u32);
+                }
+            }
+            return;
+        }
+        for (bi, b) in self.bodies.iter() {
+            if !b.awake || b.body_type == BodyType::Static {
+                continue;
+            }
+            for &ci in &b.contacts {
+                let Some(Some(c)) = self.contacts.get(ci as usize) else { continue };
+                if touching_only && !c.touching {
+                    continue;
+                }
+                // A contact between two active bodies is taken from its body A.
+                let other = if c.body_a == bi { c.body_b } else { c.body_a };
+                if c.body_a == bi || !active(other) {
+                    out.push(ci);
+                }
+            }
+        }
+        out.sort_unstable();
     }
 
     /// Builds the solver arrays from the awake bodies and touching contacts, runs the
@@ -285,8 +341,8 @@ impl World {
         let mut candidates = core::mem::take(&mut self.candidates);
         candidates.clear();
         for pass_static in [false, true] {
-            for (ci, slot) in self.contacts.iter().enumerate() {
-                let Some(c) = slot else { continue };
+            for &ci in &self.touching_contacts {
+                let Some(Some(c)) = self.contacts.get(ci as usize) else { continue };
                 if !c.touching {
                     continue;
                 }
@@ -302,7 +358,7 @@ impl World {
                     continue;
                 }
                 candidates.push(Candidate {
-                    contact: ci as u32,
+                    contact: ci,
                     bodies: ConstraintBodies {
                         index_a: ba.solver_index,
                         index_b: bb.solver_index,
@@ -400,7 +456,8 @@ impl World {
             }
             x
         }
-        for c in self.contacts.iter().flatten() {
+        for &ci in &self.touching_contacts {
+            let Some(Some(c)) = self.contacts.get(ci as usize) else { continue };
             if !c.touching {
                 continue;
             }
