@@ -98,10 +98,10 @@ pub trait Sim {
 /// Builds `kind`'s world for `scene` with `threads` worker threads where the engine allows.
 pub fn build(kind: EngineKind, scene: &SceneFile, threads: usize) -> Result<Box<dyn Sim>, BoxError> {
     Ok(match kind {
-        EngineKind::Tribo => Box::new(tribo_sim::TriboSim::build(scene)?),
+        EngineKind::Tribo => Box::new(tribo_sim::TriboSim::build(scene, threads)?),
         EngineKind::TriboMus15 => {
             let scaled = crate::scenes::scale_static_friction(scene, 1.5);
-            Box::new(tribo_sim::TriboSim::build(&scaled)?)
+            Box::new(tribo_sim::TriboSim::build(&scaled, threads)?)
         }
         EngineKind::Box2d => Box::new(box2d_sim::Box2dSim::build(scene, threads)?),
         EngineKind::Rapier => Box::new(rapier_sim::RapierSim::build(scene, threads)?),
@@ -125,7 +125,7 @@ mod tribo_sim {
     }
 
     impl TriboSim {
-        pub fn build(scene: &SceneFile) -> Result<Self, BoxError> {
+        pub fn build(scene: &SceneFile, threads: usize) -> Result<Self, BoxError> {
             let mut built = scene.build().map_err(|e| e.to_string())?;
             // tribo-scenes' SceneFile::build sets every moving body's velocity after adding
             // its shapes with World::set_body_linear_velocity, which wakes the body, so bodies
@@ -138,6 +138,11 @@ mod tribo_sim {
                     }
                 }
             }
+            let def = tribo::WorldDef {
+                workers: threads as u32,
+                ..*built.world.def()
+            };
+            built.world.set_def(def)?;
             Ok(TriboSim {
                 world: built.world,
                 bodies: built.bodies,
@@ -175,7 +180,7 @@ mod tribo_sim {
             self.world.contact_count()
         }
         fn threads(&self) -> usize {
-            1 // Tribo is single-threaded today.
+            self.world.def().workers as usize
         }
         fn awake_count(&mut self) -> usize {
             self.bodies

@@ -36,8 +36,8 @@ struct Args {
     /// Override the scene's step count N (N−1 steps are timed); for smoke runs.
     #[arg(long)]
     steps: Option<u32>,
-    /// Worker threads for Box2D (workerCount) and Rapier (its rayon pool, only with the
-    /// `rapier-parallel` feature). Tribo is single-threaded and always reports 1.
+    /// Worker threads for Tribo (`WorldDef::workers`), Box2D (workerCount) and Rapier (its
+    /// rayon pool, only with the `rapier-parallel` feature).
     #[arg(long, default_value_t = 1)]
     threads: usize,
     /// Engines to time, comma separated (tribo, box2d, rapier).
@@ -210,7 +210,7 @@ fn print_header(args: &Args) {
         env!("TRIBO_BENCH_PROFILE"),
     );
     println!(
-        "runs {}, threads {} (Tribo is single-threaded: always 1){}",
+        "runs {}, threads {}{}",
         args.runs,
         args.threads,
         if args.steps.is_some() {

@@ -68,6 +68,20 @@ pub(crate) struct Contact {
     pub touching: bool,
     /// Where the manifold was last computed, for recycling it.
     pub basis: RecycleBasis,
+    /// What the narrow phase of the current step found (read back in contact order).
+    pub outcome: NarrowOutcome,
+}
+
+/// The narrow phase's verdict on one contact in one step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) enum NarrowOutcome {
+    /// Not updated this step (no awake moving body, or a shape is gone).
+    #[default]
+    Skipped,
+    /// The fat boxes separated or the filters now forbid the pair: destroy it.
+    Destroy,
+    /// Updated; `touching` now, and whether that changed.
+    Updated { touching: bool, changed: bool },
 }
 
 /// The manifold's points as material points of the two bodies, kept from the last full

@@ -19,11 +19,12 @@
 
 use super::contact_solver::{
     build_constraint, end_substep_one, estimate, has_fresh_point, is_new_resting, record_approach, restitution_one,
-    solve_one, warm_start_one, ConstraintBodies, ContactConstraint, StepSoftness, MASS_RATIO_GROUP, MAX_LOCAL_SWEEPS,
+    solve_one, store_impulses, warm_start_one, ConstraintBodies, ContactConstraint, StepSoftness, MASS_RATIO_GROUP,
+    MAX_LOCAL_SWEEPS,
 };
 use super::contact_wide::{self, WideCold, WideContact, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
-use super::{BodyState, ConstraintSet, StepContext};
+use super::{for_each_chunk_mut, for_each_mut, for_each_mut2, ConstraintSet, States, StepContext};
 use crate::collision::contact::Contact;
 use crate::math::Vec2;
 
@@ -61,11 +62,23 @@ pub(crate) struct ContactSolver {
     /// Constraints with a point new this step.
     fresh: Vec<Slot>,
     groups: Vec<Group>,
+    /// `wide[ranges[k].0 .. ranges[k].1]`: the groups of the k-th non-empty colour.
+    ranges: Vec<(u32, u32)>,
+    /// Candidate index of each lane of each group (`u32::MAX`: empty lane).
+    lane_candidates: Vec<[u32; LANES]>,
+    /// Candidate index of each contact (`u32::MAX`: not solved this step).
+    slot_of_contact: Vec<u32>,
     // Scratch reused every step.
     colours: Vec<u8>,
     used: Vec<u32>,
     slots: Vec<Slot>,
 }
+
+/// Wide constraints per parallel chunk of a colour.
+const GROUP_CHUNK: usize = 32;
+
+/// Contacts per parallel chunk of the impulse store.
+const CONTACT_STORE_CHUNK: usize = 512;
 
 /// No colour: the constraint goes to the overflow list.
 const OVERFLOW: u8 = u8::MAX;
@@ -82,7 +95,7 @@ impl ContactSolver {
     pub fn build(
         &mut self,
         ctx: &StepContext,
-        states: &[BodyState],
+        states: &States,
         candidates: &[Candidate],
         contacts: &[Option<Contact>],
     ) {
@@ -125,71 +138,102 @@ impl ContactSolver {
         // 2. Layout: colour k fills lanes from `next[k]` on (in lanes, not groups).
         let mut next = [0u32; COLORS];
         let mut groups = 0u32;
+        self.ranges.clear();
         for k in 0..COLORS {
             next[k] = groups * LANES as u32;
+            let start = groups;
             groups += counts[k].div_ceil(LANES as u32);
+            if groups > start {
+                self.ranges.push((start, groups));
+            }
         }
-        // Every used lane is written whole by `pack`; only the block flags and the empty
-        // lanes at the end of each colour need clearing (no 1 KB-per-group memset).
+        // Every lane is written whole below (packed or cleared): no memset.
         self.wide.resize(groups as usize, WideContact::default());
         self.cold.resize(groups as usize, WideCold::default());
         self.wide.truncate(groups as usize);
         self.cold.truncate(groups as usize);
-        for (w, cold) in self.wide.iter_mut().zip(self.cold.iter_mut()) {
-            w.any_rolling = false;
-            cold.any_restitution = false;
-        }
-        for k in 0..COLORS {
-            let (end, lanes) = (next[k] + counts[k], LANES as u32);
-            if counts[k] % lanes != 0 {
-                let g = (end / lanes) as usize;
-                for l in (end % lanes) as usize..LANES {
-                    contact_wide::clear_lane(&mut self.wide[g], &mut self.cold[g], l);
-                }
-            }
-        }
-        // 3. Build and pack.
+        // 3. Slots: overflow constraints are built here, coloured ones below.
         let soft = StepSoftness::new(ctx);
         self.slots.clear();
+        self.lane_candidates.clear();
+        self.lane_candidates.resize(groups as usize, [u32::MAX; LANES]);
         let mut light: Vec<(u32, u32)> = Vec::new(); // (light body state, sweeps)
-        for (cand, &colour) in candidates.iter().zip(&self.colours) {
-            let Some(Some(c)) = contacts.get(cand.contact as usize) else {
-                // Cannot happen (candidates come from the contact list); keep the lane empty.
-                self.slots.push(Slot::Overflow(u32::MAX));
-                continue;
-            };
-            let cc = build_constraint(cand.contact, c, &cand.bodies, self.up, &soft, ctx, states);
-            if cc.inv_mass_a > 0.0 && cc.inv_mass_b > 0.0 {
-                let (ratio, body) = if cc.inv_mass_a > cc.inv_mass_b {
-                    (cc.inv_mass_a / cc.inv_mass_b, cc.index_a)
+        for (i, (cand, &colour)) in candidates.iter().zip(&self.colours).enumerate() {
+            let b = &cand.bodies;
+            if b.inv_mass_a > 0.0 && b.inv_mass_b > 0.0 {
+                let (ratio, body) = if b.inv_mass_a > b.inv_mass_b {
+                    (b.inv_mass_a / b.inv_mass_b, b.index_a)
                 } else {
-                    (cc.inv_mass_b / cc.inv_mass_a, cc.index_b)
+                    (b.inv_mass_b / b.inv_mass_a, b.index_b)
                 };
                 if ratio > MASS_RATIO_GROUP {
                     light.push((body, (ratio.ceil() as u32).min(MAX_LOCAL_SWEEPS)));
                 }
             }
             let slot = if colour == OVERFLOW {
+                let Some(Some(c)) = contacts.get(cand.contact as usize) else {
+                    // Cannot happen (candidates come from the contact list).
+                    self.slots.push(Slot::Overflow(u32::MAX));
+                    continue;
+                };
+                let cc = build_constraint(cand.contact, c, b, self.up, &soft, ctx, states);
+                if has_fresh_point(&cc) {
+                    self.fresh.push(Slot::Overflow(self.overflow.len() as u32));
+                }
                 self.overflow.push(cc);
                 Slot::Overflow(self.overflow.len() as u32 - 1)
             } else {
                 let at = next[colour as usize];
                 next[colour as usize] += 1;
                 let (group, lane) = (at / LANES as u32, at % LANES as u32);
-                let b = &cand.bodies;
-                let da = dynamic_side(b.inv_mass_a, b.inv_i_a);
-                let db = dynamic_side(b.inv_mass_b, b.inv_i_b);
-                let (w, cold) = (&mut self.wide[group as usize], &mut self.cold[group as usize]);
-                contact_wide::pack(w, cold, lane as usize, &cc, da, db);
+                self.lane_candidates[group as usize][lane as usize] = i as u32;
                 Slot::Wide {
                     group,
                     lane: lane as u8,
                 }
             };
-            if has_fresh_point(&cc) {
-                self.fresh.push(slot);
-            }
             self.slots.push(slot);
+        }
+        // 4. Build and pack the coloured constraints, four lanes per task.
+        let up = self.up;
+        let lane_candidates = &self.lane_candidates;
+        for_each_mut2(
+            ctx.parallel,
+            &mut self.wide,
+            &mut self.cold,
+            GROUP_CHUNK,
+            |g, w, cold| {
+                w.any_rolling = false;
+                cold.any_restitution = false;
+                for (l, &i) in lane_candidates[g].iter().enumerate() {
+                    let built = candidates.get(i as usize).and_then(|cand| {
+                        let c = contacts.get(cand.contact as usize)?.as_ref()?;
+                        Some((
+                            cand,
+                            build_constraint(cand.contact, c, &cand.bodies, up, &soft, ctx, states),
+                        ))
+                    });
+                    match built {
+                        Some((cand, cc)) => {
+                            let b = &cand.bodies;
+                            let da = dynamic_side(b.inv_mass_a, b.inv_i_a);
+                            let db = dynamic_side(b.inv_mass_b, b.inv_i_b);
+                            contact_wide::pack(w, cold, l, &cc, da, db);
+                        }
+                        None => contact_wide::clear_lane(w, cold, l),
+                    }
+                }
+            },
+        );
+        for (g, cold) in self.cold.iter().enumerate() {
+            for l in 0..LANES {
+                if cold.fresh[0][l] || cold.fresh[1][l] {
+                    self.fresh.push(Slot::Wide {
+                        group: g as u32,
+                        lane: l as u8,
+                    });
+                }
+            }
         }
         self.build_groups(light, candidates);
     }
@@ -252,32 +296,49 @@ impl ContactSolver {
         }
     }
 
-    /// Calls `f` with every constraint of the step in its final state, in build order
-    /// (contact order within each pass, so the contacts are written back in memory
-    /// order); wide lanes carry only what `store_impulses` reads.
-    pub fn for_each_to_store(&self, mut f: impl FnMut(&ContactConstraint)) {
-        // A template whose unread fields stay as they are for every lane.
-        let mut cc = match self.wide.first() {
-            Some(w) => contact_wide::unpack_full(w, &self.cold[0], 0),
-            None => match self.overflow.first() {
-                Some(cc) => *cc,
-                None => return,
-            },
-        };
-        for &slot in &self.slots {
-            match slot {
-                Slot::Wide { group, lane } => {
-                    let g = group as usize;
-                    contact_wide::unpack_for_store(&self.wide[g], &self.cold[g], lane as usize, &mut cc);
-                    f(&cc);
-                }
-                Slot::Overflow(i) => {
-                    if let Some(o) = self.overflow.get(i as usize) {
-                        f(o);
-                    }
-                }
+    /// Writes every constraint's impulses and friction state back into its contact
+    /// (`contacts` is the world's contact list), split between the worker threads by
+    /// contact (each writes only its own contact).
+    pub fn store(
+        &mut self,
+        ctx: &StepContext,
+        states: &States,
+        candidates: &[Candidate],
+        contacts: &mut [Option<Contact>],
+    ) {
+        let mut slot_of = core::mem::take(&mut self.slot_of_contact);
+        slot_of.clear();
+        slot_of.resize(contacts.len(), u32::MAX);
+        for (i, cand) in candidates.iter().enumerate() {
+            if let Some(x) = slot_of.get_mut(cand.contact as usize) {
+                *x = i as u32;
             }
         }
+        let this = &*self;
+        let slot_of_ref = &slot_of;
+        for_each_chunk_mut(ctx.parallel, contacts, CONTACT_STORE_CHUNK, |first, chunk| {
+            // A template whose fields that storing does not read stay as they are.
+            let mut cc = ContactConstraint::default();
+            for (k, slot) in chunk.iter_mut().enumerate() {
+                let (Some(c), Some(&i)) = (slot.as_mut(), slot_of_ref.get(first + k)) else {
+                    continue;
+                };
+                match this.slots.get(i as usize) {
+                    Some(&Slot::Wide { group, lane }) => {
+                        let g = group as usize;
+                        contact_wide::unpack_for_store(&this.wide[g], &this.cold[g], lane as usize, &mut cc);
+                        store_impulses(&cc, c, states, ctx);
+                    }
+                    Some(&Slot::Overflow(o)) => {
+                        if let Some(oc) = this.overflow.get(o as usize) {
+                            store_impulses(oc, c, states, ctx);
+                        }
+                    }
+                    None => {}
+                }
+            }
+        });
+        self.slot_of_contact = slot_of;
     }
 }
 
@@ -286,7 +347,7 @@ impl ConstraintSet for ContactSolver {
         !self.fresh.is_empty()
     }
 
-    fn estimate_new_contacts(&mut self, ctx: &StepContext, trial: &mut [BodyState]) -> bool {
+    fn estimate_new_contacts(&mut self, ctx: &StepContext, trial: &States) -> bool {
         let mut subset = Vec::new();
         let mut slots = Vec::new();
         for &slot in &self.fresh {
@@ -312,24 +373,33 @@ impl ConstraintSet for ContactSolver {
         true
     }
 
-    fn warm_start(&mut self, states: &mut [BodyState]) {
+    fn warm_start(&mut self, ctx: &StepContext, states: &States) {
         for cc in &mut self.overflow {
             warm_start_one(cc, states);
         }
-        for w in &mut self.wide {
-            contact_wide::warm_start(w, states);
+        for &(start, end) in &self.ranges {
+            let colour = &mut self.wide[start as usize..end as usize];
+            for_each_mut(ctx.parallel, colour, GROUP_CHUNK, |_, w| {
+                contact_wide::warm_start(w, states)
+            });
         }
     }
 
-    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, elapsed: f32) {
+    fn solve(&mut self, ctx: &StepContext, states: &States, use_bias: bool, elapsed: f32) {
         for cc in &mut self.overflow {
             solve_one(cc, states, ctx, use_bias, elapsed);
         }
-        for w in &mut self.wide {
+        // Colour after colour; the groups of one colour share no moving body.
+        for &(start, end) in &self.ranges {
+            let colour = &mut self.wide[start as usize..end as usize];
             if use_bias {
-                contact_wide::solve::<true>(w, states, ctx, elapsed);
+                for_each_mut(ctx.parallel, colour, GROUP_CHUNK, |_, w| {
+                    contact_wide::solve::<true>(w, states, ctx, elapsed)
+                });
             } else {
-                contact_wide::solve::<false>(w, states, ctx, elapsed);
+                for_each_mut(ctx.parallel, colour, GROUP_CHUNK, |_, w| {
+                    contact_wide::solve::<false>(w, states, ctx, elapsed)
+                });
             }
         }
         // Extra local sweeps where a light body carries a heavy one, in the relax pass only:
@@ -367,7 +437,7 @@ impl ConstraintSet for ContactSolver {
         }
     }
 
-    fn restitution(&mut self, states: &mut [BodyState]) {
+    fn restitution(&mut self, states: &States) {
         for cc in &mut self.overflow {
             restitution_one(cc, states);
         }

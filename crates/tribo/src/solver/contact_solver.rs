@@ -52,7 +52,7 @@
 //! The two normal rows of a 2-point manifold are solved together (a 2×2 LCP, Box2D v2.4's
 //! block solver in soft form), so one iteration is exact within the manifold.
 
-use super::{BodyState, Softness, StepContext};
+use super::{BodyState, Softness, States, StepContext};
 use crate::collision::contact::{Contact, FrictionState};
 use crate::math::Vec2;
 
@@ -87,7 +87,7 @@ pub(crate) struct ConstraintPoint {
 }
 
 /// Solver data of one contact.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct ContactConstraint {
     pub index_a: u32,
     pub index_b: u32,
@@ -146,7 +146,7 @@ pub(crate) fn build_constraint(
     up: Vec2,
     soft: &StepSoftness,
     ctx: &StepContext,
-    states: &[BodyState],
+    states: &States,
 ) -> ContactConstraint {
     let mut cc = ContactConstraint {
         index_a: bodies.index_a,
@@ -191,7 +191,7 @@ pub(crate) fn build_constraint(
     let n = cc.normal;
     let t = n.right_perp();
     let masses = cc_masses(bodies);
-    let (sa, sb) = (states[cc.index_a as usize], states[cc.index_b as usize]);
+    let (sa, sb) = load(states, cc.index_a, cc.index_b);
     if cc.restitution > 0.0 {
         cc.kinetic_energy = pair_kinetic_energy(&cc, &sa, &sb);
     }
@@ -278,7 +278,7 @@ pub(crate) fn has_fresh_point(cc: &ContactConstraint) -> bool {
 }
 
 /// Records each point's normal velocity under `states` (the approach speed of new points).
-pub(crate) fn record_approach(cc: &mut ContactConstraint, states: &[BodyState]) {
+pub(crate) fn record_approach(cc: &mut ContactConstraint, states: &States) {
     let (a, b) = load(states, cc.index_a, cc.index_b);
     for i in 0..cc.count {
         let (r_a, r_b) = (cc.points[i].r_a, cc.points[i].r_b);
@@ -299,7 +299,7 @@ pub(crate) fn is_new_resting(cc: &ContactConstraint) -> bool {
 /// against `trial`, the states after one substep of forces: first the top-down statics
 /// pass ([`statics_estimate`]), then sequential sweeps from the top down until the
 /// normal impulses settle. Sets each point's preload to its estimate.
-pub(crate) fn estimate(subset: &mut [ContactConstraint], up: Vec2, ctx: &StepContext, trial: &mut [BodyState]) {
+pub(crate) fn estimate(subset: &mut [ContactConstraint], up: Vec2, ctx: &StepContext, trial: &States) {
     if subset.is_empty() {
         return;
     }
@@ -345,7 +345,7 @@ pub(crate) fn estimate(subset: &mut [ContactConstraint], up: Vec2, ctx: &StepCon
 /// for stacks and pyramids (statically determinate per body) and a good start for piles;
 /// the rigid sweeps that follow correct it. Sequential sweeps alone need on the order of
 /// N² sweeps to carry the weight of an N-high stack to the ground.
-pub(crate) fn statics_estimate(subset: &mut [ContactConstraint], up: Vec2, trial: &mut [BodyState]) {
+pub(crate) fn statics_estimate(subset: &mut [ContactConstraint], up: Vec2, trial: &States) {
     if up == Vec2::ZERO {
         return;
     }
@@ -376,7 +376,7 @@ pub(crate) fn statics_estimate(subset: &mut [ContactConstraint], up: Vec2, trial
         *f = (*f).min(k as u32);
     }
     supports.sort_by_key(|s| (first[s.0 as usize], s.1));
-    let mut load = vec![0.0f32; n_states];
+    let mut carried = vec![0.0f32; n_states];
     let mut moment = vec![0.0f32; n_states];
     let mut start = 0;
     while start < supports.len() {
@@ -394,9 +394,9 @@ pub(crate) fn statics_estimate(subset: &mut [ContactConstraint], up: Vec2, trial
             subset[i0].inv_mass_a
         };
         // Own weight: the impulse that stops this substep's fall, acting at the centre.
-        let fall = (-trial[upper as usize].v.dot(up)).max(0.0);
+        let fall = (-trial[upper as usize].load().v.dot(up)).max(0.0);
         let own = fall / inv_m;
-        let w_total = own + load[upper as usize];
+        let w_total = own + carried[upper as usize];
         if w_total <= 0.0 {
             continue;
         }
@@ -443,7 +443,7 @@ pub(crate) fn statics_estimate(subset: &mut [ContactConstraint], up: Vec2, trial
                     .map(|p| if upper_is_b { p.r_a } else { p.r_b }.dot(lat))
                     .sum::<f32>()
                     / count as f32;
-                load[lower as usize] += w;
+                carried[lower as usize] += w;
                 moment[lower as usize] += w * x_lower;
             }
         }
@@ -451,7 +451,7 @@ pub(crate) fn statics_estimate(subset: &mut [ContactConstraint], up: Vec2, trial
     // The trial velocities must carry the impulses the sweeps start from.
     for &(_, ci, _) in &supports {
         let cc = &subset[ci];
-        let (mut a, mut b) = load_states(trial, cc.index_a, cc.index_b);
+        let (mut a, mut b) = load(trial, cc.index_a, cc.index_b);
         for cp in &cc.points[..cc.count] {
             apply(cc, &mut a, &mut b, cp.r_a, cp.r_b, cp.normal_impulse * cc.normal);
         }
@@ -671,28 +671,23 @@ fn anchor_displacement(a: &BodyState, b: &BodyState, r_a: Vec2, r_b: Vec2) -> Ve
 
 /// Reads two body states; index 0 is the shared static body, never written.
 #[inline]
-fn load_states(states: &[BodyState], ia: u32, ib: u32) -> (BodyState, BodyState) {
-    load(states, ia, ib)
+fn load(states: &States, ia: u32, ib: u32) -> (BodyState, BodyState) {
+    (states[ia as usize].load(), states[ib as usize].load())
 }
 
 #[inline]
-fn load(states: &[BodyState], ia: u32, ib: u32) -> (BodyState, BodyState) {
-    (states[ia as usize], states[ib as usize])
-}
-
-#[inline]
-fn store(states: &mut [BodyState], ia: u32, ib: u32, a: BodyState, b: BodyState) {
+fn store(states: &States, ia: u32, ib: u32, a: BodyState, b: BodyState) {
     if ia != 0 {
-        states[ia as usize] = a;
+        states[ia as usize].store(a);
     }
     if ib != 0 {
-        states[ib as usize] = b;
+        states[ib as usize].store(b);
     }
 }
 
 /// Restitution for one constraint (after all substeps): points that approached faster
 /// than the threshold and took load bounce with `e` times their approach speed.
-pub(crate) fn restitution_one(cc: &mut ContactConstraint, states: &mut [BodyState]) {
+pub(crate) fn restitution_one(cc: &mut ContactConstraint, states: &States) {
     if cc.restitution == 0.0 {
         return;
     }
@@ -769,7 +764,7 @@ pub(crate) fn restitution_one(cc: &mut ContactConstraint, states: &mut [BodyStat
 
 /// Re-applies one constraint's accumulated impulses at the start of a substep, after
 /// recording its points' normal velocities (restitution's impact speed).
-pub(crate) fn warm_start_one(cc: &mut ContactConstraint, states: &mut [BodyState]) {
+pub(crate) fn warm_start_one(cc: &mut ContactConstraint, states: &States) {
     let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
     let n = cc.normal;
     let t = n.right_perp();
@@ -787,13 +782,7 @@ pub(crate) fn warm_start_one(cc: &mut ContactConstraint, states: &mut [BodyState
 }
 
 /// One pass over one contact: normal rows, friction rows, rolling resistance.
-pub(crate) fn solve_one(
-    cc: &mut ContactConstraint,
-    states: &mut [BodyState],
-    ctx: &StepContext,
-    use_bias: bool,
-    elapsed: f32,
-) {
+pub(crate) fn solve_one(cc: &mut ContactConstraint, states: &States, ctx: &StepContext, use_bias: bool, elapsed: f32) {
     let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
     solve_normals(cc, &mut a, &mut b, ctx, use_bias);
     if cc.points[..cc.count].iter().any(|p| p.normal_impulse > 0.0) {
@@ -938,7 +927,7 @@ fn solve_rolling(cc: &mut ContactConstraint, a: &mut BodyState, b: &mut BodyStat
 
 /// Writes impulses back into the contact and runs the stick/slip transitions
 /// (store stage). `states` are the end-of-step states.
-pub(crate) fn store_impulses(cc: &ContactConstraint, contact: &mut Contact, states: &[BodyState], ctx: &StepContext) {
+pub(crate) fn store_impulses(cc: &ContactConstraint, contact: &mut Contact, states: &States, ctx: &StepContext) {
     let (a, b) = load(states, cc.index_a, cc.index_b);
     let t = cc.normal.right_perp();
     contact.rolling_impulse = cc.rolling_impulse;

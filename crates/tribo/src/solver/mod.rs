@@ -26,6 +26,7 @@ pub(crate) mod wide;
 
 use crate::math::{Rot, Vec2};
 use crate::world::{Profile, Stopwatch};
+use core::sync::atomic::{AtomicU64, Ordering};
 pub(crate) use softness::Softness;
 
 /// Velocity and accumulated motion of one awake body during a step (32 bytes, hot).
@@ -42,6 +43,80 @@ pub(crate) struct BodyState {
     pub dp: Vec2,
     /// Rotation since the start of the step.
     pub dq: Rot,
+}
+
+/// A body's [`BodyState`] as four atomic 64-bit words (two floats each), so the worker
+/// threads of a step can share the states: within one colour of the constraint graph no
+/// two constraints touch the same moving body, and relaxed loads and stores are plain
+/// moves on 64-bit targets, so sharing needs no `unsafe` and costs little.
+#[derive(Debug, Default)]
+#[repr(align(32))]
+pub(crate) struct SharedState([AtomicU64; 4]);
+
+/// The solver's body states (index 0: every static body).
+pub(crate) type States = [SharedState];
+
+#[inline(always)]
+fn pack2(a: f32, b: f32) -> u64 {
+    (a.to_bits() as u64) | ((b.to_bits() as u64) << 32)
+}
+
+#[inline(always)]
+fn unpack2(x: u64) -> (f32, f32) {
+    (f32::from_bits(x as u32), f32::from_bits((x >> 32) as u32))
+}
+
+impl SharedState {
+    pub fn new(s: BodyState) -> SharedState {
+        let out = SharedState::default();
+        out.store(s);
+        out
+    }
+
+    #[inline(always)]
+    fn get(&self, i: usize) -> (f32, f32) {
+        unpack2(self.0[i].load(Ordering::Relaxed))
+    }
+
+    #[inline(always)]
+    fn set(&self, i: usize, a: f32, b: f32) {
+        self.0[i].store(pack2(a, b), Ordering::Relaxed);
+    }
+
+    #[inline(always)]
+    pub fn load(&self) -> BodyState {
+        let (vx, vy) = self.get(0);
+        let (w, touched) = self.get(1);
+        let (px, py) = self.get(2);
+        let (c, s) = self.get(3);
+        BodyState {
+            v: Vec2::new(vx, vy),
+            w,
+            touched,
+            dp: Vec2::new(px, py),
+            dq: Rot { c, s },
+        }
+    }
+
+    #[inline(always)]
+    pub fn store(&self, s: BodyState) {
+        self.store_velocity(s.v, s.w, s.touched);
+        self.set(2, s.dp.x, s.dp.y);
+        self.set(3, s.dq.c, s.dq.s);
+    }
+
+    /// Writes only what a constraint pass changes.
+    #[inline(always)]
+    pub fn store_velocity(&self, v: Vec2, w: f32, touched: f32) {
+        self.set(0, v.x, v.y);
+        self.set(1, w, touched);
+    }
+}
+
+impl Clone for SharedState {
+    fn clone(&self) -> Self {
+        SharedState::new(self.load())
+    }
 }
 
 /// Per-body constants of a step (cold relative to [`BodyState`]).
@@ -74,6 +149,79 @@ pub(crate) struct StepContext {
     /// Largest linear speed [m/s].
     pub max_linear_speed: f32,
     pub warm_starting: bool,
+    /// The step runs inside the world's thread pool: split the work between its threads.
+    pub parallel: bool,
+}
+
+/// Calls `f(i, &mut items[i])` for every item, split between the pool's threads when
+/// `parallel` (chunks of at least `min_len` items), else in order on this thread. `f` must
+/// not depend on the order (each item only writes itself and what no other item writes).
+pub(crate) fn for_each_mut<T: Send>(parallel: bool, items: &mut [T], min_len: usize, f: impl Fn(usize, &mut T) + Sync) {
+    if parallel {
+        use rayon::prelude::*;
+        items
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(min_len)
+            .for_each(|(i, x)| f(i, x));
+    } else {
+        for (i, x) in items.iter_mut().enumerate() {
+            f(i, x);
+        }
+    }
+}
+
+/// Like [`for_each_mut`] over two slices of the same length, item by item.
+pub(crate) fn for_each_mut2<A: Send, B: Send>(
+    parallel: bool,
+    a: &mut [A],
+    b: &mut [B],
+    min_len: usize,
+    f: impl Fn(usize, &mut A, &mut B) + Sync,
+) {
+    if parallel {
+        use rayon::prelude::*;
+        a.par_iter_mut()
+            .zip(b.par_iter_mut())
+            .enumerate()
+            .with_min_len(min_len)
+            .for_each(|(i, (x, y))| f(i, x, y));
+    } else {
+        for (i, (x, y)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
+            f(i, x, y);
+        }
+    }
+}
+
+/// Calls `f(first, chunk)` for consecutive chunks of `chunk_len` items (`first`: index of
+/// the chunk's first item), split between the pool's threads when `parallel`.
+pub(crate) fn for_each_chunk_mut<T: Send>(
+    parallel: bool,
+    items: &mut [T],
+    chunk_len: usize,
+    f: impl Fn(usize, &mut [T]) + Sync,
+) {
+    if parallel {
+        use rayon::prelude::*;
+        items
+            .par_chunks_mut(chunk_len)
+            .enumerate()
+            .for_each(|(k, chunk)| f(k * chunk_len, chunk));
+    } else {
+        for (k, chunk) in items.chunks_mut(chunk_len).enumerate() {
+            f(k * chunk_len, chunk);
+        }
+    }
+}
+
+/// Like [`for_each_mut`] over `0..n` with shared access only.
+pub(crate) fn for_each_index(parallel: bool, n: usize, min_len: usize, f: impl Fn(usize) + Sync) {
+    if parallel {
+        use rayon::prelude::*;
+        (0..n).into_par_iter().with_min_len(min_len).for_each(|i| f(i));
+    } else {
+        (0..n).for_each(f);
+    }
 }
 
 /// A family of constraints solved by the step (contacts now; joints later). The set is
@@ -84,15 +232,15 @@ pub(crate) trait ConstraintSet {
     /// Estimates warm-start impulses for constraints that begin at rest (no history):
     /// rigid iterations against `trial`, the states after one substep of forces. Returns
     /// whether any constraint was estimated. The trial velocities are thrown away.
-    fn estimate_new_contacts(&mut self, ctx: &StepContext, trial: &mut [BodyState]) -> bool;
+    fn estimate_new_contacts(&mut self, ctx: &StepContext, trial: &States) -> bool;
     /// Re-applies the accumulated impulses at the start of a substep.
-    fn warm_start(&mut self, states: &mut [BodyState]);
+    fn warm_start(&mut self, ctx: &StepContext, states: &States);
     /// One sequential-impulse pass; `use_bias` adds the soft position correction.
-    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, elapsed: f32);
+    fn solve(&mut self, ctx: &StepContext, states: &States, use_bias: bool, elapsed: f32);
     /// Accumulates what a substep applied (after its relax pass).
     fn end_substep(&mut self);
     /// Restitution pass after all substeps.
-    fn restitution(&mut self, states: &mut [BodyState]);
+    fn restitution(&mut self, states: &States);
 }
 
 /// Runs the stages of one step over the awake bodies and a constraint set, timing each
@@ -100,7 +248,7 @@ pub(crate) trait ConstraintSet {
 pub(crate) fn solve_step<C: ConstraintSet>(
     ctx: &StepContext,
     sims: &[BodySim],
-    states: &mut [BodyState],
+    states: &States,
     constraints: &mut C,
     profile: &mut Profile,
 ) {
@@ -109,9 +257,9 @@ pub(crate) fn solve_step<C: ConstraintSet>(
     // body sag and slide before the load builds up (the settling creep of Box2D and
     // Rapier). Estimate its impulses first on a scratch copy of the states.
     if constraints.has_new_contacts() {
-        let mut trial = states.to_vec();
-        integrate_velocities(ctx, sims, &mut trial);
-        constraints.estimate_new_contacts(ctx, &mut trial);
+        let trial = states.to_vec();
+        integrate_velocities(ctx, sims, &trial);
+        constraints.estimate_new_contacts(ctx, &trial);
     }
     profile.prepare = lap.lap();
     let mut t = [0.0f32; 5];
@@ -120,7 +268,7 @@ pub(crate) fn solve_step<C: ConstraintSet>(
         t[0] += lap.lap();
         // Always called: it also records approach speeds (impulses are zero when warm
         // starting is off).
-        constraints.warm_start(states);
+        constraints.warm_start(ctx, states);
         t[1] += lap.lap();
         let elapsed = i as f32 * ctx.h;
         constraints.solve(ctx, states, true, elapsed);
@@ -142,17 +290,25 @@ pub(crate) fn solve_step<C: ConstraintSet>(
     profile.restitution = lap.lap();
 }
 
+/// Bodies per parallel chunk of the integration stages.
+const BODY_CHUNK: usize = 512;
+
 /// v ← (v + h·a) / (1 + h·c): explicit forces, Padé damping (Box2D v3).
-fn integrate_velocities(ctx: &StepContext, sims: &[BodySim], states: &mut [BodyState]) {
+fn integrate_velocities(ctx: &StepContext, sims: &[BodySim], states: &States) {
     let h = ctx.h;
     // Index 0 is the shared static body: it never moves.
-    for (sim, s) in sims.iter().zip(states.iter_mut()).skip(1) {
+    for_each_index(ctx.parallel, sims.len(), BODY_CHUNK, |k| {
+        if k == 0 {
+            return;
+        }
+        let (sim, state) = (&sims[k], &states[k]);
+        let s = state.load();
         let lin = 1.0 / (1.0 + h * sim.linear_damping);
         let ang = 1.0 / (1.0 + h * sim.angular_damping);
-        s.v = (s.v + h * sim.linear_accel) * lin;
-        s.w = (s.w + h * sim.angular_accel) * ang;
-        s.touched = 0.0;
-    }
+        let v = (s.v + h * sim.linear_accel) * lin;
+        let w = (s.w + h * sim.angular_accel) * ang;
+        state.store_velocity(v, w, 0.0);
+    });
 }
 
 /// Accumulates Δp += h·v and Δq ← Δq advanced by h·ω, with speed limits.
@@ -161,13 +317,18 @@ fn integrate_velocities(ctx: &StepContext, sims: &[BodySim], states: &mut [BodyS
 /// the exact displacement under the constant acceleration a of gravity and applied forces
 /// (plain symplectic Euler overshoots by ½h²a per substep, which makes a dropped ball hit
 /// slower and bounce lower than e²h by about (1 + 1/e)·g·h/v).
-fn integrate_positions(ctx: &StepContext, sims: &[BodySim], states: &mut [BodyState]) {
+fn integrate_positions(ctx: &StepContext, sims: &[BodySim], states: &States) {
     let h = ctx.h;
     // Rotation per substep is limited to 0.25π per full step, as in Box2D, so the
     // first-order rotation update stays accurate.
     let max_w = 0.25 * core::f32::consts::PI / ctx.dt;
     let max_v2 = ctx.max_linear_speed * ctx.max_linear_speed;
-    for (sim, s) in sims.iter().zip(states.iter_mut()).skip(1) {
+    for_each_index(ctx.parallel, sims.len(), BODY_CHUNK, |k| {
+        if k == 0 {
+            return;
+        }
+        let (sim, state) = (&sims[k], &states[k]);
+        let mut s = state.load();
         if s.v.length_squared() > max_v2 {
             s.v = s.v * (ctx.max_linear_speed / s.v.length());
         }
@@ -179,5 +340,6 @@ fn integrate_positions(ctx: &StepContext, sims: &[BodySim], states: &mut [BodySt
             h * s.v
         };
         s.dq = s.dq.integrate(h * s.w);
-    }
+        state.store(s);
+    });
 }

@@ -27,7 +27,7 @@ use crate::error::{check_finite, check_non_negative, check_positive, check_vec, 
 use crate::geometry::{Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Aabb, Transform, Vec2};
 use crate::solver::contact_set::{Candidate, ContactSolver};
-use crate::solver::{BodySim, BodyState};
+use crate::solver::{BodySim, SharedState};
 
 /// World settings. Every field has a default (listed on the field) that matches Box2D v3
 /// where Box2D has the same setting, so scenes port.
@@ -54,6 +54,13 @@ pub struct WorldDef {
     pub time_to_sleep: f32,
     /// Whether impulses carry over between steps. Default true.
     pub warm_starting: bool,
+    /// Threads that work on a step, 1..=256. Default 1 (the calling thread only). With more,
+    /// the world owns a pool of that many threads; the narrow phase, the constraint set-up,
+    /// every colour of the solver and the impulse store are split between them. Results
+    /// are bit-identical for every count: the work is split only where the parts cannot
+    /// affect each other (constraints of one graph colour share no moving body) and
+    /// gathered back in a fixed order.
+    pub workers: u32,
 }
 
 impl Default for WorldDef {
@@ -69,6 +76,7 @@ impl Default for WorldDef {
             enable_sleep: true,
             time_to_sleep: 0.5,
             warm_starting: true,
+            workers: 1,
         }
     }
 }
@@ -89,6 +97,12 @@ impl WorldDef {
         check_non_negative("WorldDef::stick_speed", self.stick_speed)?;
         check_positive("WorldDef::max_linear_speed", self.max_linear_speed)?;
         check_non_negative("WorldDef::time_to_sleep", self.time_to_sleep)?;
+        if self.workers == 0 || self.workers > 256 {
+            return Err(Error::arg(
+                "WorldDef::workers",
+                format!("must be in 1..=256 (got {})", self.workers),
+            ));
+        }
         Ok(())
     }
 }
@@ -108,7 +122,7 @@ pub struct World {
     /// Bodies whose state became non-finite in the last step (frozen and reported).
     pub(crate) non_finite: Vec<BodyId>,
     // Scratch buffers reused every step (no per-step allocation once warm).
-    pub(crate) states: Vec<BodyState>,
+    pub(crate) states: Vec<SharedState>,
     pub(crate) sims: Vec<BodySim>,
     pub(crate) contact_solver: ContactSolver,
     pub(crate) candidates: Vec<Candidate>,
@@ -118,8 +132,24 @@ pub struct World {
     pub(crate) touching_contacts: Vec<u32>,
     pub(crate) scratch_u32: Vec<u32>,
     pub(crate) scratch_f32: Vec<f32>,
+    pub(crate) scratch_mark: Vec<bool>,
     pub(crate) step_count: u64,
     pub(crate) profile: Profile,
+    /// Worker threads when `def.workers > 1`.
+    pub(crate) pool: Option<rayon::ThreadPool>,
+}
+
+/// Makes the thread pool for `workers` threads (none for 1).
+fn make_pool(workers: u32) -> Result<Option<rayon::ThreadPool>> {
+    if workers <= 1 {
+        return Ok(None);
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(workers as usize)
+        .thread_name(|i| format!("tribo-worker-{i}"))
+        .build()
+        .map(Some)
+        .map_err(|e| Error::arg("WorldDef::workers", format!("cannot start {workers} threads: {e}")))
 }
 
 impl World {
@@ -145,8 +175,10 @@ impl World {
             touching_contacts: Vec::new(),
             scratch_u32: Vec::new(),
             scratch_f32: Vec::new(),
+            scratch_mark: Vec::new(),
             step_count: 0,
             profile: Profile::default(),
+            pool: make_pool(def.workers)?,
         })
     }
 
@@ -163,6 +195,9 @@ impl World {
     /// Replaces the settings (validated first; on error nothing changes).
     pub fn set_def(&mut self, def: WorldDef) -> Result<()> {
         def.validate()?;
+        if def.workers != self.def.workers {
+            self.pool = make_pool(def.workers)?;
+        }
         self.def = def;
         Ok(())
     }

@@ -8,14 +8,17 @@
 
 use super::{ContactBeginEvent, ContactEndEvent, Stopwatch, World};
 use crate::collision::broad_phase::{MOVING_TREE, STATIC_TREE};
-use crate::collision::contact::{pair_key, Contact, PointState};
+use crate::collision::contact::{pair_key, Contact, NarrowOutcome, PointState};
+use crate::dynamics::body::Body;
+use crate::dynamics::shape::ShapeRecord;
 use crate::dynamics::{mix, BodyType};
 use crate::error::{Error, Result};
 use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::Candidate;
-use crate::solver::contact_solver::{store_impulses, ConstraintBodies};
-use crate::solver::{solve_step, BodySim, BodyState, StepContext};
+use crate::solver::contact_solver::ConstraintBodies;
+use crate::solver::{for_each_mut, solve_step, BodySim, BodyState, SharedState, StepContext};
+use crate::world::Arena;
 use crate::world::BodyId;
 
 impl World {
@@ -32,13 +35,26 @@ impl World {
         if dt == 0.0 {
             return Ok(());
         }
+        match self.pool.take() {
+            Some(pool) => {
+                // Inside the pool the parallel stages split their work between its threads.
+                pool.install(|| self.run_step(dt, true));
+                self.pool = Some(pool);
+            }
+            None => self.run_step(dt, false),
+        }
+        Ok(())
+    }
+
+    /// The stages of one step; `parallel`: running inside the world's thread pool.
+    fn run_step(&mut self, dt: f32, parallel: bool) {
         let mut total = Stopwatch::start();
         let mut lap = Stopwatch::start();
         self.update_pairs();
         self.profile.pairs = lap.lap();
-        self.collide(dt);
+        self.collide(dt, parallel);
         self.profile.collide = lap.lap();
-        let ctx = self.step_context(dt);
+        let ctx = self.step_context(dt, parallel);
         self.solve(&ctx);
         lap.lap();
         self.finalize(dt);
@@ -47,10 +63,9 @@ impl World {
         self.profile.sleep = lap.lap();
         self.profile.step = total.lap();
         self.step_count += 1;
-        Ok(())
     }
 
-    fn step_context(&self, dt: f32) -> StepContext {
+    fn step_context(&self, dt: f32, parallel: bool) -> StepContext {
         let substeps = self.def.substeps.max(1);
         let h = dt / substeps as f32;
         // Box2D v3 clamps the contact frequency to 1/8 of the substep rate.
@@ -67,6 +82,7 @@ impl World {
             stick_speed: self.def.stick_speed,
             max_linear_speed: self.def.max_linear_speed,
             warm_starting: self.def.warm_starting,
+            parallel,
         }
     }
 
@@ -161,6 +177,7 @@ impl World {
             rolling_impulse: 0.0,
             touching: false,
             basis: Default::default(),
+            outcome: NarrowOutcome::Skipped,
         };
         let (body_a, body_b) = (contact.body_a, contact.body_b);
         let ci = match self.contact_free.pop() {
@@ -181,64 +198,60 @@ impl World {
         }
     }
 
-    /// Narrow phase: update the manifold of every contact with an awake moving body;
-    /// destroy contacts whose fat boxes separated; report begin/end; wake sleepers.
-    fn collide(&mut self, dt: f32) {
-        let mut to_destroy = Vec::new();
-        let mut to_wake = Vec::new();
+    /// Narrow phase: update the manifold of every contact with an awake moving body (split
+    /// between the worker threads: each contact only writes itself); then, in contact
+    /// order, destroy contacts whose fat boxes separated, report begin/end, wake sleepers.
+    fn collide(&mut self, dt: f32, parallel: bool) {
         let mut active = core::mem::take(&mut self.active_contacts);
         self.collect_active_contacts(&mut active, false);
+        let mut mark = core::mem::take(&mut self.scratch_mark);
+        mark.clear();
+        mark.resize(self.contacts.len(), false);
+        for &ci in &active {
+            mark[ci as usize] = true;
+        }
+        let (bodies, shapes) = (&self.bodies, &self.shapes);
+        for_each_mut(parallel, &mut self.contacts, CONTACT_CHUNK, |ci, slot| {
+            if let (Some(c), true) = (slot.as_mut(), mark[ci]) {
+                c.outcome = narrow_phase(c, bodies, shapes, dt);
+            }
+        });
+        self.scratch_mark = mark;
+        let mut to_destroy = Vec::new();
+        let mut to_wake = Vec::new();
         let mut touching = core::mem::take(&mut self.touching_contacts);
         touching.clear();
         for &ci in &active {
-            let ci = ci as usize;
-            let Some(c) = self.contacts[ci].as_mut() else { continue };
-            let (Some(ba), Some(bb)) = (self.bodies.at(c.body_a), self.bodies.at(c.body_b)) else {
+            let Some(c) = self.contacts[ci as usize].as_mut() else {
                 continue;
             };
-            let active_a = ba.awake && ba.body_type != BodyType::Static;
-            let active_b = bb.awake && bb.body_type != BodyType::Static;
-            if !active_a && !active_b {
-                continue;
-            }
-            let (Some(sa), Some(sb)) = (
-                self.shapes.get(c.shape_a.index, c.shape_a.generation),
-                self.shapes.get(c.shape_b.index, c.shape_b.generation),
-            ) else {
-                continue;
-            };
-            if !sa.fat_aabb.overlaps(sb.fat_aabb) || !sa.filter.should_collide(&sb.filter) {
-                to_destroy.push(ci as u32);
-                continue;
-            }
-            // Speculative margin grows with the relative motion of the step, so fast
-            // bodies meet thin ground before they can pass it.
-            let rel = (bb.v - ba.v).length() + ba.w.abs() * ba.max_extent + bb.w.abs() * bb.max_extent;
-            let margin = SPECULATIVE_DISTANCE + dt * rel;
-            let was = c.touching;
-            let now = c.recycle(ba.xf, bb.xf, ba.max_extent + bb.max_extent)
-                || c.update(&sa.geometry, ba.xf, &sb.geometry, bb.xf, margin);
-            if now && !was {
-                self.events.begin.push(ContactBeginEvent {
-                    shape_a: c.shape_a,
-                    shape_b: c.shape_b,
-                    normal: c.manifold.normal,
-                    point: c.manifold.points[0].point,
-                });
-                if !ba.awake {
-                    to_wake.push(c.body_a);
+            let outcome = core::mem::take(&mut c.outcome);
+            match outcome {
+                NarrowOutcome::Skipped => {}
+                NarrowOutcome::Destroy => to_destroy.push(ci),
+                NarrowOutcome::Updated { touching: now, changed } => {
+                    if now {
+                        touching.push(ci);
+                    }
+                    if changed && now {
+                        self.events.begin.push(ContactBeginEvent {
+                            shape_a: c.shape_a,
+                            shape_b: c.shape_b,
+                            normal: c.manifold.normal,
+                            point: c.manifold.points[0].point,
+                        });
+                        for bi in [c.body_a, c.body_b] {
+                            if self.bodies.at(bi).is_some_and(|b| !b.awake) {
+                                to_wake.push(bi);
+                            }
+                        }
+                    } else if changed {
+                        self.events.end.push(ContactEndEvent {
+                            shape_a: c.shape_a,
+                            shape_b: c.shape_b,
+                        });
+                    }
                 }
-                if !bb.awake {
-                    to_wake.push(c.body_b);
-                }
-            } else if was && !now {
-                self.events.end.push(ContactEndEvent {
-                    shape_a: c.shape_a,
-                    shape_b: c.shape_b,
-                });
-            }
-            if now {
-                touching.push(ci as u32);
             }
         }
         self.active_contacts = active;
@@ -267,7 +280,11 @@ impl World {
                 .at(bi)
                 .is_some_and(|b| b.awake && b.body_type != BodyType::Static)
         };
-        let awake = self.bodies.iter().filter(|(_, b)| b.awake && b.body_type != BodyType::Static).count();
+        let awake = self
+            .bodies
+            .iter()
+            .filter(|(_, b)| b.awake && b.body_type != BodyType::Static)
+            .count();
         if 2 * awake > self.bodies.len() {
             // Mostly awake: one pass in memory order beats chasing the bodies' lists.
             for (ci, c) in self.contacts.iter().enumerate() {
@@ -283,7 +300,9 @@ impl World {
                 continue;
             }
             for &ci in &b.contacts {
-                let Some(Some(c)) = self.contacts.get(ci as usize) else { continue };
+                let Some(Some(c)) = self.contacts.get(ci as usize) else {
+                    continue;
+                };
                 if touching_only && !c.touching {
                     continue;
                 }
@@ -304,7 +323,7 @@ impl World {
         let g = self.def.gravity;
         self.states.clear();
         self.sims.clear();
-        self.states.push(BodyState::default()); // index 0: every static body
+        self.states.push(SharedState::new(BodyState::default())); // index 0: every static body
         self.sims.push(BodySim::default());
         let capacity = self.bodies.capacity();
         for bi in 0..capacity as u32 {
@@ -314,13 +333,13 @@ impl World {
                 continue;
             }
             b.solver_index = self.states.len() as u32;
-            self.states.push(BodyState {
+            self.states.push(SharedState::new(BodyState {
                 v: b.v,
                 w: b.w,
                 touched: 0.0,
                 dp: Vec2::ZERO,
                 dq: Rot::IDENTITY,
-            });
+            }));
             let dynamic = b.body_type == BodyType::Dynamic;
             let force = b.force + b.constant_force;
             let torque = b.torque + b.constant_torque;
@@ -342,7 +361,9 @@ impl World {
         candidates.clear();
         for pass_static in [false, true] {
             for &ci in &self.touching_contacts {
-                let Some(Some(c)) = self.contacts.get(ci as usize) else { continue };
+                let Some(Some(c)) = self.contacts.get(ci as usize) else {
+                    continue;
+                };
                 if !c.touching {
                     continue;
                 }
@@ -377,14 +398,9 @@ impl World {
         solver.build(ctx, &self.states, &candidates, &self.contacts);
         self.candidates = candidates;
         self.profile.solver_setup = lap.lap();
-        solve_step(ctx, &self.sims, &mut self.states, &mut solver, &mut self.profile);
+        solve_step(ctx, &self.sims, &self.states, &mut solver, &mut self.profile);
         lap.lap();
-        let (contacts, states) = (&mut self.contacts, &self.states);
-        solver.for_each_to_store(|cc| {
-            if let Some(Some(c)) = contacts.get_mut(cc.contact as usize) {
-                store_impulses(cc, c, states, ctx);
-            }
-        });
+        solver.store(ctx, &self.states, &self.candidates, &mut self.contacts);
         self.contact_solver = solver;
         self.profile.store = lap.lap();
     }
@@ -392,7 +408,7 @@ impl World {
     /// Writes the solver's motion back to the bodies, refreshes fat boxes and sleep timers.
     fn finalize(&mut self, dt: f32) {
         for k in 1..self.states.len() {
-            let s = self.states[k];
+            let s = self.states[k].load();
             let bi = self.sims[k].body;
             let Some(b) = self.bodies.at_mut(bi) else { continue };
             b.force = Vec2::ZERO;
@@ -457,7 +473,9 @@ impl World {
             x
         }
         for &ci in &self.touching_contacts {
-            let Some(Some(c)) = self.contacts.get(ci as usize) else { continue };
+            let Some(Some(c)) = self.contacts.get(ci as usize) else {
+                continue;
+            };
             if !c.touching {
                 continue;
             }
@@ -508,6 +526,42 @@ impl World {
     /// Bodies frozen in the last step because their state became non-finite.
     pub fn non_finite_bodies(&self) -> &[BodyId] {
         &self.non_finite
+    }
+}
+
+/// Contacts per parallel chunk of the narrow phase and the impulse store.
+const CONTACT_CHUNK: usize = 256;
+
+/// Updates one contact's manifold (recycled when its bodies barely moved); reads only the
+/// bodies and shapes, so contacts can be updated in parallel.
+fn narrow_phase(c: &mut Contact, bodies: &Arena<Body>, shapes: &Arena<ShapeRecord>, dt: f32) -> NarrowOutcome {
+    let (Some(ba), Some(bb)) = (bodies.at(c.body_a), bodies.at(c.body_b)) else {
+        return NarrowOutcome::Skipped;
+    };
+    let active_a = ba.awake && ba.body_type != BodyType::Static;
+    let active_b = bb.awake && bb.body_type != BodyType::Static;
+    if !active_a && !active_b {
+        return NarrowOutcome::Skipped;
+    }
+    let (Some(sa), Some(sb)) = (
+        shapes.get(c.shape_a.index, c.shape_a.generation),
+        shapes.get(c.shape_b.index, c.shape_b.generation),
+    ) else {
+        return NarrowOutcome::Skipped;
+    };
+    if !sa.fat_aabb.overlaps(sb.fat_aabb) || !sa.filter.should_collide(&sb.filter) {
+        return NarrowOutcome::Destroy;
+    }
+    // Speculative margin grows with the relative motion of the step, so fast bodies meet
+    // thin ground before they can pass it.
+    let rel = (bb.v - ba.v).length() + ba.w.abs() * ba.max_extent + bb.w.abs() * bb.max_extent;
+    let margin = SPECULATIVE_DISTANCE + dt * rel;
+    let was = c.touching;
+    let now = c.recycle(ba.xf, bb.xf, ba.max_extent + bb.max_extent)
+        || c.update(&sa.geometry, ba.xf, &sb.geometry, bb.xf, margin);
+    NarrowOutcome::Updated {
+        touching: now,
+        changed: now != was,
     }
 }
 
