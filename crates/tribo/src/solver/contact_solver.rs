@@ -314,10 +314,14 @@ pub(crate) fn estimate(subset: &mut [ContactConstraint], up: Vec2, ctx: &StepCon
     for _ in 0..sweeps {
         let (mut change, mut largest) = (0.0f32, 0.0f32);
         for cc in subset.iter_mut() {
-            let before = [cc.points[0].normal_impulse, cc.points[1].normal_impulse];
+            // Both rows count: a start from the statics pass can have the normal impulses
+            // right while friction (and through it the moments) is still settling.
+            let before = cc.points.map(|p| (p.normal_impulse, p.tangent_impulse));
             solve_one(cc, trial, ctx, false, 0.0);
-            for (k, cp) in cc.points[..cc.count].iter().enumerate() {
-                change = change.max((cp.normal_impulse - before[k]).abs());
+            for (cp, (n, t)) in cc.points[..cc.count].iter().zip(before) {
+                change = change
+                    .max((cp.normal_impulse - n).abs())
+                    .max((cp.tangent_impulse - t).abs());
                 largest = largest.max(cp.normal_impulse);
             }
         }

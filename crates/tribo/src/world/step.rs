@@ -557,7 +557,7 @@ fn narrow_phase(c: &mut Contact, bodies: &Arena<Body>, shapes: &Arena<ShapeRecor
     let rel = (bb.v - ba.v).length() + ba.w.abs() * ba.max_extent + bb.w.abs() * bb.max_extent;
     let margin = SPECULATIVE_DISTANCE + dt * rel;
     let was = c.touching;
-    let now = c.recycle(ba.xf, bb.xf, ba.max_extent + bb.max_extent)
+    let now = c.recycle(ba.xf, bb.xf, 2.0 * ba.max_extent.min(bb.max_extent))
         || c.update(&sa.geometry, ba.xf, &sb.geometry, bb.xf, margin);
     NarrowOutcome::Updated {
         touching: now,
