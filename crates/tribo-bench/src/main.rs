@@ -489,8 +489,9 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
                 passed,
                 text: format!(
                     "{outside} of {} boxes outside the drum (|x|,|y| < {limit} m in its frame; max {max_abs:.3} m); \
-                     drum angle {measured:.4} rad vs ω t = {expected:.4} (err {angle_err:.1e})",
-                    dynamic.len()
+                     drum angle {measured:.4} rad vs ω t = {expected:.4} ≡ {:.4} rad (err {angle_err:.1e})",
+                    dynamic.len(),
+                    measured - angle_err
                 ),
                 json: json!({"boxes_outside": outside, "boxes": dynamic.len(), "max_local_abs_m": max_abs,
                              "limit_m": limit, "drum_angle_rad": measured, "drum_angle_expected_rad": expected,
