@@ -10,6 +10,8 @@
 # directory keeps that build apart from the workspace's (and from the tests' smoke build).
 #
 # Usage: crates/tribo-bench/run.sh [SCENE|all] [--runs R] [--steps N] [--threads T] [--json FILE] [--profile]
+#        crates/tribo-bench/run.sh scaling [--sizes 1000,4000,16000,64000] [--runs R] [--large-runs R64] [--steps N] [--json FILE]
+# (SCENE: large_pyramid, many_pyramids, smash, tumbler, scaling_rain_<n>; every argument is passed to the program.)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 export CFLAGS="${CFLAGS:--O3 -DNDEBUG}"

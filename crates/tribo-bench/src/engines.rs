@@ -79,6 +79,8 @@ pub trait Sim {
     fn step(&mut self) -> Result<(), BoxError>;
     /// Origin of scene body `i`.
     fn position(&mut self, i: usize) -> [f32; 2];
+    /// Rotation angle [rad] of scene body `i` (in (−π, π]).
+    fn angle(&mut self, i: usize) -> f32;
     /// Centre-of-mass velocity of scene body `i`.
     fn velocity(&mut self, i: usize) -> [f32; 2];
     /// Mass of scene body `i` (0 for static bodies).
@@ -166,6 +168,9 @@ mod tribo_sim {
                 .body_position(self.bodies[i])
                 .map(arr)
                 .unwrap_or([f32::NAN; 2])
+        }
+        fn angle(&mut self, i: usize) -> f32 {
+            self.world.body_angle(self.bodies[i]).unwrap_or(f32::NAN)
         }
         fn velocity(&mut self, i: usize) -> [f32; 2] {
             self.world
@@ -379,6 +384,12 @@ mod box2d_sim {
                 Err(_) => [f32::NAN; 2],
             }
         }
+        fn angle(&mut self, i: usize) -> f32 {
+            match self.world.body(self.bodies[i]).and_then(|b| b.rotation()) {
+                Ok(q) => q.angle(),
+                Err(_) => f32::NAN,
+            }
+        }
         fn velocity(&mut self, i: usize) -> [f32; 2] {
             match self.world.body(self.bodies[i]).and_then(|b| b.linear_velocity()) {
                 Ok(p) => [p.x, p.y],
@@ -561,6 +572,9 @@ mod rapier_sim {
         fn position(&mut self, i: usize) -> [f32; 2] {
             let t = self.world.bodies[self.bodies[i]].translation();
             [t.x, t.y]
+        }
+        fn angle(&mut self, i: usize) -> f32 {
+            self.world.bodies[self.bodies[i]].rotation().angle()
         }
         fn velocity(&mut self, i: usize) -> [f32; 2] {
             let l = self.world.bodies[self.bodies[i]].linvel();

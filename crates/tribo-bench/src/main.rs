@@ -5,6 +5,10 @@
 //! 1 … N−1; repeat for R runs. Runs are interleaved (run 1 of every engine, then run 2, …)
 //! so background noise spreads over all engines. Reported: ms/step median and min over runs.
 //!
+//! `tribo-bench scaling` instead runs the scaling scenes (`scaling_rain_<n>`: n bodies
+//! raining into a container whose width grows ∝ n) for every n of `--sizes` and prints
+//! ms/step and µs/step per body for each n and engine.
+//!
 //! Build Box2D with release C flags: `CFLAGS="-O3 -DNDEBUG"` (see run.sh).
 
 mod engines;
@@ -12,7 +16,7 @@ mod scenes;
 
 use clap::Parser;
 use engines::{BoxError, EngineKind, Sim};
-use scenes::{BenchScene, CheckKind, SCENES};
+use scenes::{BenchScene, CheckKind};
 use serde_json::json;
 use std::io::Write;
 use std::time::Instant;
@@ -24,7 +28,8 @@ use tribo_scenes::format::{BodyKind, SceneFile};
     about = "Tribo vs Box2D v3 vs Rapier on Box2D's benchmark scenes"
 )]
 struct Args {
-    /// Scene to run: large_pyramid, many_pyramids, smash, or all.
+    /// Scene to run: large_pyramid, many_pyramids, smash, tumbler, or all (these four);
+    /// `scaling` runs the scaling scenes of `--sizes` instead; `scaling_rain_<n>` runs one.
     #[arg(default_value = "all", value_name = "SCENE")]
     scene_pos: String,
     /// Same as the positional SCENE (overrides it).
@@ -33,6 +38,13 @@ struct Args {
     /// Runs per engine and scene (median and min are over these).
     #[arg(long, default_value_t = 5)]
     runs: usize,
+    /// Scaling run: body counts n of the `scaling_rain_<n>` scenes, comma separated.
+    #[arg(long, default_value = "1000,4000,16000,64000", value_delimiter = ',')]
+    sizes: Vec<usize>,
+    /// Scaling run: runs for scenes of more than 20 000 bodies (at most `--runs`); one run
+    /// of the 64 000-body scene takes about a minute per engine on a 2-core machine.
+    #[arg(long, default_value_t = 1)]
+    large_runs: usize,
     /// Override the scene's step count N (N−1 steps are timed); for smoke runs.
     #[arg(long)]
     steps: Option<u32>,
@@ -43,7 +55,7 @@ struct Args {
     /// Engines to time, comma separated (tribo, box2d, rapier).
     #[arg(long, default_value = "tribo,box2d,rapier", value_delimiter = ',')]
     engines: Vec<String>,
-    /// Skip the second table (Tribo with μs = 1.5 μd).
+    /// Skip the second table (Tribo with μs = 1.5 μd); the scaling run always skips it.
     #[arg(long)]
     no_friction_table: bool,
     /// Write one JSON line per (scene, engine) to this file ("-" = stdout).
@@ -60,6 +72,16 @@ struct Check {
     passed: bool,
     text: String,
     json: serde_json::Value,
+}
+
+/// One scene's results, for the summary tables.
+struct SceneResult {
+    name: String,
+    /// Dynamic bodies.
+    dynamic: usize,
+    /// Steps per run (the first untimed).
+    steps: u32,
+    results: Vec<EngineResult>,
 }
 
 /// Everything measured for one (scene, engine).
@@ -102,14 +124,30 @@ fn main() {
 
 fn run(args: &Args) -> Result<(), BoxError> {
     let scene_name = args.scene.clone().unwrap_or_else(|| args.scene_pos.clone());
-    let selected: Vec<&BenchScene> = if scene_name == "all" {
-        SCENES.iter().collect()
+    let scaling = scene_name == "scaling";
+    let selected: Vec<BenchScene> = if scaling {
+        if args.sizes.is_empty() || args.sizes.contains(&0) {
+            return Err("--sizes needs body counts of at least 1".into());
+        }
+        args.sizes.iter().map(|&n| scenes::scaling_scene(n)).collect()
+    } else if scene_name == "all" {
+        scenes::scenes()
+    } else if let Some(n) = scene_name
+        .strip_prefix("scaling_rain_")
+        .and_then(|n| n.parse::<usize>().ok())
+        .filter(|&n| n > 0)
+    {
+        vec![scenes::scaling_scene(n)]
     } else {
-        let s = SCENES.iter().find(|s| s.name == scene_name).ok_or_else(|| {
-            let names: Vec<&str> = SCENES.iter().map(|s| s.name).collect();
-            format!("unknown scene {scene_name} (known: {}, all)", names.join(", "))
+        let mut all = scenes::scenes();
+        let names: Vec<String> = all.iter().map(|s| s.name.clone()).collect();
+        let i = all.iter().position(|s| s.name == scene_name).ok_or_else(|| {
+            format!(
+                "unknown scene {scene_name} (known: {}, all, scaling, scaling_rain_<n>)",
+                names.join(", ")
+            )
         })?;
-        vec![s]
+        vec![all.swap_remove(i)]
     };
     let mut kinds = Vec::new();
     for e in &args.engines {
@@ -120,11 +158,11 @@ fn run(args: &Args) -> Result<(), BoxError> {
             other => return Err(format!("unknown engine {other} (tribo, box2d, rapier)").into()),
         });
     }
-    if !args.no_friction_table && kinds.contains(&EngineKind::Tribo) {
+    if !args.no_friction_table && !scaling && kinds.contains(&EngineKind::Tribo) {
         kinds.push(EngineKind::TriboMus15);
     }
-    if args.runs == 0 {
-        return Err("--runs must be at least 1".into());
+    if args.runs == 0 || args.large_runs == 0 {
+        return Err("--runs and --large-runs must be at least 1".into());
     }
     if args.threads == 0 {
         return Err("--threads must be at least 1".into());
@@ -137,12 +175,18 @@ fn run(args: &Args) -> Result<(), BoxError> {
 
     print_header(args);
     let mut all_results = Vec::new();
-    for bench in selected {
+    for bench in &selected {
         let mut scene = (bench.build)();
         if let Some(n) = args.steps {
             scene.steps = n.max(2);
         }
-        let results = run_scene(bench, &scene, &kinds, args)?;
+        let dynamic = dynamic_count(&scene);
+        let runs = if scaling && dynamic > 20_000 {
+            args.large_runs.min(args.runs)
+        } else {
+            args.runs
+        };
+        let results = run_scene(bench, &scene, &kinds, args, runs)?;
         print_scene_table(bench, &scene, &results, args);
         if let Some(out) = json_out.as_mut() {
             for r in &results {
@@ -156,21 +200,36 @@ fn run(args: &Args) -> Result<(), BoxError> {
                     "ms_per_step_median": r.median(),
                     "ms_per_step_min": r.min(),
                     "ms_per_step_runs": r.ms,
+                    "us_per_step_per_body_median": 1000.0 * r.median() / dynamic as f64,
                     "build_s_median": median(&r.build_s),
                     "check_passed": r.all_passed,
                     "check": r.check.as_ref().map(|c| c.json.clone()),
                     "contacts": r.contacts,
                     "bodies": scene.bodies.len(),
+                    "dynamic_bodies": dynamic,
                 });
                 writeln!(out, "{line}")?;
             }
+            out.flush()?;
         }
-        all_results.push((bench.name, results));
+        all_results.push(SceneResult {
+            name: bench.name.clone(),
+            dynamic,
+            steps: scene.steps,
+            results,
+        });
     }
     if kinds.contains(&EngineKind::TriboMus15) {
         print_friction_table(&all_results);
     }
+    if scaling {
+        print_scaling_table(&all_results, &selected, args);
+    }
     Ok(())
+}
+
+fn dynamic_count(scene: &SceneFile) -> usize {
+    scene.bodies.iter().filter(|b| b.kind == BodyKind::Dynamic).count()
 }
 
 fn median(v: &[f64]) -> f64 {
@@ -233,6 +292,7 @@ fn run_scene(
     scene: &SceneFile,
     kinds: &[EngineKind],
     args: &Args,
+    runs: usize,
 ) -> Result<Vec<EngineResult>, BoxError> {
     let mut results: Vec<EngineResult> = kinds
         .iter()
@@ -248,7 +308,7 @@ fn run_scene(
         })
         .collect();
     let timed = scene.steps - 1;
-    for run in 0..args.runs {
+    for run in 0..runs {
         for r in results.iter_mut() {
             let t_build = Instant::now();
             let mut sim = engines::build(r.kind, scene, args.threads)?;
@@ -273,7 +333,7 @@ fn run_scene(
                 "  {} run {}/{} {:<13} {:>9.3} ms/step (build {:.2} s; awake bodies at build/after step 0/end: {}/{}/{}) {}",
                 bench.name,
                 run + 1,
-                args.runs,
+                runs,
                 r.kind.name(),
                 ms,
                 build_s,
@@ -304,7 +364,12 @@ fn run_scene(
 /// drift less than 0.5 m sideways. Smash: the projectile must have hit and ploughed into the block
 /// (final x in (30, 180) m, final speed in (1, 39) m/s; 180 m and 40 m/s would mean it
 /// passed through untouched) and total linear momentum must be conserved within 1 %
-/// (no gravity, no static bodies). Every dynamic body's position must stay finite.
+/// (no gravity, no static bodies). Tumbler: every box centre, turned into the drum's frame
+/// (the drum's angle is ω t, t = steps · dt: it is kinematic), must be inside the drum,
+/// |x|, |y| < 9.5 m (the inner faces of its walls), and the engine's own drum angle must be
+/// ω t within 0.01 rad. Scaling rain: every body centre must be inside the container,
+/// |x| < its inner half width and y > 0 m (the floor's top). Every dynamic body's position
+/// must stay finite.
 fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
     let dynamic: Vec<usize> = (0..scene.bodies.len())
         .filter(|&i| scene.bodies[i].kind == BodyKind::Dynamic)
@@ -321,8 +386,8 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
         }
     }
     match bench.check {
-        CheckKind::Pyramid => {
-            let max_drop = 0.01 * bench.stack_layers as f32;
+        CheckKind::Pyramid { stack_layers } => {
+            let max_drop = 0.01 * stack_layers as f32;
             let y_top = dynamic
                 .iter()
                 .map(|&i| scene.bodies[i].position[1])
@@ -390,6 +455,73 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
                              "momentum_rel_error": err, "finite": finite}),
             }
         }
+        CheckKind::Tumbler => {
+            let drum = scene
+                .bodies
+                .iter()
+                .position(|b| b.kind == BodyKind::Kinematic)
+                .unwrap_or(0);
+            let c = scene.bodies[drum].position;
+            let t = scene.steps as f32 * scene.dt;
+            let expected = scene.bodies[drum].angle + scene.bodies[drum].angular_velocity * t;
+            let measured = sim.angle(drum);
+            // Difference wrapped to (−π, π].
+            let tau = std::f32::consts::TAU;
+            let angle_err = (measured - expected + std::f32::consts::PI).rem_euclid(tau) - std::f32::consts::PI;
+            let (s, co) = expected.sin_cos();
+            let limit = 9.5f32;
+            let (mut outside, mut max_abs) = (0usize, 0.0f32);
+            for &i in &dynamic {
+                let p = sim.position(i);
+                let d = [p[0] - c[0], p[1] - c[1]];
+                // Into the drum's frame: rotate by −angle.
+                let local = [co * d[0] + s * d[1], -s * d[0] + co * d[1]];
+                let m = local[0].abs().max(local[1].abs());
+                if m.is_nan() || m >= limit {
+                    outside += 1;
+                }
+                if m.is_finite() {
+                    max_abs = max_abs.max(m);
+                }
+            }
+            let passed = finite && outside == 0 && angle_err.abs() < 0.01;
+            Check {
+                passed,
+                text: format!(
+                    "{outside} of {} boxes outside the drum (|x|,|y| < {limit} m in its frame; max {max_abs:.3} m); \
+                     drum angle {measured:.4} rad vs ω t = {expected:.4} ≡ {:.4} rad (err {angle_err:.1e})",
+                    dynamic.len(),
+                    measured - angle_err
+                ),
+                json: json!({"boxes_outside": outside, "boxes": dynamic.len(), "max_local_abs_m": max_abs,
+                             "limit_m": limit, "drum_angle_rad": measured, "drum_angle_expected_rad": expected,
+                             "finite": finite}),
+            }
+        }
+        CheckKind::Rain { half_width } => {
+            let (mut outside, mut y_top, mut y_low) = (0usize, f32::NEG_INFINITY, f32::INFINITY);
+            for &i in &dynamic {
+                let p = sim.position(i);
+                if !(p[0].abs() < half_width && p[1] > 0.0) {
+                    outside += 1;
+                }
+                if p[1].is_finite() {
+                    y_top = y_top.max(p[1]);
+                    y_low = y_low.min(p[1]);
+                }
+            }
+            let passed = finite && outside == 0;
+            Check {
+                passed,
+                text: format!(
+                    "{outside} of {} bodies outside the container (|x| < {half_width} m, y > 0); \
+                     body centres at y {y_low:.3} … {y_top:.2} m",
+                    dynamic.len()
+                ),
+                json: json!({"bodies_outside": outside, "bodies": dynamic.len(), "half_width_m": half_width,
+                             "lowest_y_m": y_low, "highest_y_m": y_top, "finite": finite}),
+            }
+        }
     }
 }
 
@@ -404,6 +536,9 @@ fn print_scene_table(bench: &BenchScene, scene: &SceneFile, results: &[EngineRes
         results.first().map_or(0, |r| r.ms.len()),
         if scene.enable_sleep { "on" } else { "off" }
     );
+    if !bench.note.is_empty() {
+        println!("   note: {}", bench.note);
+    }
     let tribo = results.iter().find(|r| r.kind == EngineKind::Tribo);
     println!(
         "{:<8} {:>7} {:>14} {:>11} {:>14} {:>11} {:>9}  check (last run)",
@@ -439,13 +574,13 @@ fn print_scene_table(bench: &BenchScene, scene: &SceneFile, results: &[EngineRes
     println!();
 }
 
-fn print_friction_table(all: &[(&str, Vec<EngineResult>)]) {
+fn print_friction_table(all: &[SceneResult]) {
     println!("== Tribo: cost of the static/dynamic friction model (every shape's μs scaled by 1.5, μd unchanged)");
     println!(
         "{:<14} {:>16} {:>18} {:>8} {:>14} {:>16}  check μs = 1.5 μd (last run)",
         "scene", "μs=μd median ms", "μs=1.5μd median ms", "ratio", "μs=μd min ms", "μs=1.5μd min ms"
     );
-    for (name, results) in all {
+    for SceneResult { name, results, .. } in all {
         let a = results.iter().find(|r| r.kind == EngineKind::Tribo);
         let b = results.iter().find(|r| r.kind == EngineKind::TriboMus15);
         if let (Some(a), Some(b)) = (a, b) {
@@ -463,4 +598,70 @@ fn print_friction_table(all: &[(&str, Vec<EngineResult>)]) {
         }
     }
     println!("(ratio = μs=1.5μd / μs=μd, medians)");
+}
+
+/// The scaling summary: per body count n and engine, ms/step, µs/step per dynamic body and
+/// Tribo/peer ratios.
+fn print_scaling_table(all: &[SceneResult], selected: &[BenchScene], args: &Args) {
+    let steps = all.first().map_or(0, |s| s.steps);
+    println!(
+        "== scaling: n bodies (2/3 boxes half 0.25 m, 1/3 disks r 0.25 m) rain into a container 1 m wide per 20 bodies"
+    );
+    println!(
+        "   (width ∝ n, so the pile is equally deep for every n), sleep off, {steps} steps ({} timed), threads {}",
+        steps.saturating_sub(1),
+        args.threads
+    );
+    println!(
+        "{:>7} {:<8} {:>4} {:>14} {:>11} {:>14} {:>11} {:>14} {:>11}  check",
+        "bodies",
+        "engine",
+        "runs",
+        "median ms/step",
+        "min ms/step",
+        "med µs/body",
+        "min µs/body",
+        "Tribo/peer med",
+        "Tribo/peer min"
+    );
+    for (
+        SceneResult {
+            dynamic: n, results, ..
+        },
+        bench,
+    ) in all.iter().zip(selected)
+    {
+        let tribo = results.iter().find(|r| r.kind == EngineKind::Tribo);
+        for r in results {
+            let (rm, rn) = match tribo {
+                Some(t) => (
+                    format!("{:.2}", t.median() / r.median()),
+                    format!("{:.2}", t.min() / r.min()),
+                ),
+                None => ("-".into(), "-".into()),
+            };
+            println!(
+                "{:>7} {:<8} {:>4} {:>14.3} {:>11.3} {:>14.3} {:>11.3} {:>14} {:>11}  {}{}",
+                n,
+                r.kind.name(),
+                r.ms.len(),
+                r.median(),
+                r.min(),
+                1000.0 * r.median() / *n as f64,
+                1000.0 * r.min() / *n as f64,
+                rm,
+                rn,
+                if r.all_passed { "PASS" } else { "FAIL" },
+                match &bench.check {
+                    CheckKind::Rain { .. } => r
+                        .check
+                        .as_ref()
+                        .and_then(|c| c.json["bodies_outside"].as_u64())
+                        .map_or(String::new(), |k| format!(" ({k} outside)")),
+                    _ => String::new(),
+                }
+            );
+        }
+    }
+    println!("(µs/body = µs per step per dynamic body; Tribo/peer = Tribo's ms/step / the peer's)");
 }

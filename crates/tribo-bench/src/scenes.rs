@@ -1,54 +1,94 @@
 //! The benchmark scenes (engine-neutral [`SceneFile`]s) and scene transformations.
 //!
-//! `large_pyramid` and `many_pyramids` come from `tribo_scenes::scenes`; `smash` is built
-//! here following shared/SCENES.md §2 (Box2D v3's `CreateSmash`).
+//! `large_pyramid`, `many_pyramids` and `tumbler` (`tumbler_benchmark`: Box2D's scene with
+//! a kinematic drum instead of a motor-driven dynamic one) come from
+//! `tribo_scenes::scenes`; `smash` is built here following shared/SCENES.md §2 (Box2D v3's
+//! `CreateSmash`). The scaling run's scenes are `tribo_scenes::scenes::scaling_rain(n)`.
 
 use tribo_scenes::format::{BodyKind, BodySpec, MaterialRef, MaterialSpec, SceneFile, ShapeSpec};
 
 /// What the stability check of a scene looks at.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum CheckKind {
     /// Top box(es) must neither drop (more than 10 mm per stacked layer, i.e. twice Box2D's
     /// 5 mm linear slop that each resting contact may keep as penetration) nor drift
     /// sideways by 0.5 m or more.
-    Pyramid,
+    Pyramid {
+        /// Boxes stacked under (and including) the top box, for the drop limit.
+        stack_layers: u32,
+    },
     /// The projectile must hit and plough into the block; momentum is conserved.
     Smash,
+    /// Every box's centre, in the frame of the kinematic drum (body 0; angle ω t), must
+    /// stay inside the drum: |x|, |y| < 9.5 m (the walls' inner faces); the engine's own
+    /// drum angle must match ω t within 0.01 rad.
+    Tumbler,
+    /// Every body's centre must stay inside the container: |x| < `half_width` (the walls'
+    /// inner faces) and y > 0 (the floor's top face).
+    Rain {
+        /// Inner half width of the container [m].
+        half_width: f32,
+    },
 }
 
 /// A benchmark scene.
 pub struct BenchScene {
     /// Name on the command line and in the JSON.
-    pub name: &'static str,
+    pub name: String,
     /// Builds the scene.
-    pub build: fn() -> SceneFile,
+    pub build: Box<dyn Fn() -> SceneFile>,
     /// Which check applies.
     pub check: CheckKind,
-    /// Boxes stacked under (and including) the top box, for the pyramid check's drop limit.
-    pub stack_layers: u32,
+    /// How the scene differs from Box2D's, printed under the table header ("" = none).
+    pub note: &'static str,
 }
 
-/// Every benchmark scene, in the order `all` runs them.
-pub const SCENES: &[BenchScene] = &[
-    BenchScene {
-        name: "large_pyramid",
-        build: tribo_scenes::scenes::large_pyramid,
-        check: CheckKind::Pyramid,
-        stack_layers: 100,
-    },
-    BenchScene {
-        name: "many_pyramids",
-        build: tribo_scenes::scenes::many_pyramids,
-        check: CheckKind::Pyramid,
-        stack_layers: 10,
-    },
-    BenchScene {
-        name: "smash",
-        build: smash,
-        check: CheckKind::Smash,
-        stack_layers: 0,
-    },
-];
+impl BenchScene {
+    fn new(name: &str, build: impl Fn() -> SceneFile + 'static, check: CheckKind) -> BenchScene {
+        BenchScene {
+            name: name.into(),
+            build: Box::new(build),
+            check,
+            note: "",
+        }
+    }
+}
+
+/// Every Box2D benchmark scene, in the order `all` runs them.
+pub fn scenes() -> Vec<BenchScene> {
+    vec![
+        BenchScene::new(
+            "large_pyramid",
+            tribo_scenes::scenes::large_pyramid,
+            CheckKind::Pyramid { stack_layers: 100 },
+        ),
+        BenchScene::new(
+            "many_pyramids",
+            tribo_scenes::scenes::many_pyramids,
+            CheckKind::Pyramid { stack_layers: 10 },
+        ),
+        BenchScene::new("smash", smash, CheckKind::Smash),
+        BenchScene {
+            note: "drum is KINEMATIC at a fixed 25°/s in all three engines (Box2D's scene: dynamic drum, \
+                   density 50, on a revolute motor; Tribo has no joints yet)",
+            ..BenchScene::new("tumbler", tribo_scenes::scenes::tumbler_benchmark, CheckKind::Tumbler)
+        },
+    ]
+}
+
+/// The scaling scene with `n` bodies ([`tribo_scenes::scenes::scaling_rain`]), named
+/// `scaling_rain_<n>`.
+pub fn scaling_scene(n: usize) -> BenchScene {
+    let mut b = BenchScene::new(
+        &format!("scaling_rain_{n}"),
+        move || tribo_scenes::scenes::scaling_rain(n),
+        CheckKind::Rain {
+            half_width: tribo_scenes::scenes::rain_half_width(n),
+        },
+    );
+    b.note = "not a Box2D scene: container width ∝ n (constant pile depth), sleep off";
+    b
+}
 
 fn box_shape(hx: f32, hy: f32, material: MaterialSpec) -> ShapeSpec {
     ShapeSpec {

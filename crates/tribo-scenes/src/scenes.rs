@@ -63,6 +63,17 @@ pub const SCENES: &[SceneEntry] = &[
         build: tumbler,
     },
     SceneEntry {
+        name: "tumbler_benchmark",
+        about:
+            "Box2D v3 benchmark tumbler: 2 025 small boxes in a 20 m drum turning at 25°/s (kinematic here), 750 steps",
+        build: tumbler_benchmark,
+    },
+    SceneEntry {
+        name: "scaling_rain_1k",
+        about: "1 000 boxes and disks raining into a 50 m wide container (the smallest benchmark scaling scene)",
+        build: scaling_rain_1k,
+    },
+    SceneEntry {
         name: "large_pyramid",
         about: "Box2D v3 benchmark: a 100-row pyramid of 5 050 boxes, sleep off, 500 steps",
         build: large_pyramid,
@@ -425,6 +436,167 @@ pub fn tumbler() -> SceneFile {
     s
 }
 
+/// Angular velocity of the tumbler benchmark's drum [rad/s]: 25°/s ≈ 0.436 rad/s.
+pub const TUMBLER_DRUM_SPEED: f32 = 25.0 * core::f32::consts::PI / 180.0;
+
+/// Centre of the tumbler benchmark's drum [m].
+pub const TUMBLER_DRUM_CENTER: [f32; 2] = [0.0, 10.0];
+
+/// Box2D v3's tumbler benchmark scene (SCENES.md §2, `CreateTumbler`), with one
+/// difference: the drum is a **kinematic** body turning at a fixed 25°/s
+/// ([`TUMBLER_DRUM_SPEED`], ≈ 0.436 rad/s, counter-clockwise) about its centre (0, 10) m.
+/// In Box2D's scene the drum is a *dynamic* body (density 50) driven by a revolute-joint
+/// motor (25°/s, max torque 1e8 N·m) to a static ground body; Tribo has no joints yet, so
+/// the benchmark gives every engine the kinematic drum (same work for all three; the
+/// motor joint, its solver row and the drum's own dynamics are absent, and the drum never
+/// slows down under the load of the boxes).
+///
+/// Drum: four boxes, half (0.5, 10) m at (±10, 0) m and half (10, 0.5) m at (0, ±10) m in
+/// the drum's frame, so the inside is 19 m × 19 m; density 50 kg/m² (kept from Box2D's
+/// scene; no effect on a kinematic body). Contents: 45 × 45 = 2 025 dynamic boxes, half
+/// 0.125 m, density 1 kg/m², friction 0.6, at x = −9 + 0.4 j, y = 1 + 0.4 i m (row i,
+/// column j). Gravity (0, −10) m/s², 60 Hz, 4 substeps, sleep on, 750 steps (12.5 s,
+/// 312.5° of drum rotation).
+pub fn tumbler_benchmark() -> SceneFile {
+    let mut s = scene(
+        "Box2D v3 benchmark tumbler with a kinematic drum at 25°/s (Box2D: dynamic drum on a revolute motor)",
+        750,
+    );
+    s.gravity = [0.0, -10.0];
+    s.enable_sleep = true;
+    s.materials.insert(
+        "drum".into(),
+        MaterialSpec {
+            density: Some(50.0),
+            friction: Some(0.6),
+            ..MaterialSpec::default()
+        },
+    );
+    s.materials.insert(
+        "box".into(),
+        MaterialSpec {
+            density: Some(1.0),
+            friction: Some(0.6),
+            ..MaterialSpec::default()
+        },
+    );
+    let mut drum = body(
+        Some("drum".into()),
+        BodyKind::Kinematic,
+        TUMBLER_DRUM_CENTER,
+        0.0,
+        Vec::new(),
+    );
+    drum.angular_velocity = TUMBLER_DRUM_SPEED;
+    for (center, half) in [
+        ([10.0f32, 0.0f32], [0.5f32, 10.0f32]),
+        ([-10.0, 0.0], [0.5, 10.0]),
+        ([0.0, 10.0], [10.0, 0.5]),
+        ([0.0, -10.0], [10.0, 0.5]),
+    ] {
+        drum.shapes.push(ShapeSpec {
+            center: Some(center),
+            ..box_shape(half[0], half[1], named("drum"))
+        });
+    }
+    s.bodies.push(drum);
+    for i in 0..45 {
+        for j in 0..45 {
+            let p = [-9.0 + 0.4 * j as f32, 1.0 + 0.4 * i as f32];
+            s.bodies.push(body(
+                None,
+                BodyKind::Dynamic,
+                p,
+                0.0,
+                vec![box_shape(0.125, 0.125, named("box"))],
+            ));
+        }
+    }
+    s
+}
+
+/// Rows of bodies in a [`scaling_rain`] scene's starting grid.
+pub const RAIN_ROWS: usize = 20;
+
+/// Inner half width [m] of the container of a [`scaling_rain`] scene with `n` bodies:
+/// 1 m per column of the starting grid, so the width grows ∝ n and the pile depth stays
+/// the same for every n.
+pub fn rain_half_width(n: usize) -> f32 {
+    0.5 * n.div_ceil(RAIN_ROWS) as f32
+}
+
+/// A scaling benchmark scene: `n` bodies rain into a wide static container.
+///
+/// Bodies: 2 of every 3 are boxes of half 0.25 m, every third a disk of radius 0.25 m;
+/// density 1 kg/m², friction 0.6, restitution 0. They start at rest in a grid of
+/// [`RAIN_ROWS`] rows and ⌈n / 20⌉ columns, 1 m apart (odd rows shifted by 0.5 m), the
+/// lowest row 1 m above the floor, each body jittered by up to ±0.15 m sideways and
+/// (boxes) turned by up to ±0.5 rad, from a fixed hash of its index (every scene of size n
+/// is the same). The rows land one after another and form a pile about 12 bodies
+/// (≈ 6 m) deep.
+///
+/// Container (one static body): floor top at y = 0, inner width 2 · [`rain_half_width`]
+/// = ⌈n / 20⌉ m — **∝ n**, so the pile depth, and the contacts per body, do not depend
+/// on n — and walls 1 m thick rising to y = 25 m (4 m above the highest start).
+/// Gravity (0, −10) m/s², 60 Hz, 4 substeps, **sleep off** (every body is solved every
+/// step in every engine, whatever its sleep heuristics), 300 steps (5 s).
+pub fn scaling_rain(n: usize) -> SceneFile {
+    let mut s = scene(&format!("scaling rain: {n} boxes and disks into a container"), 300);
+    s.gravity = [0.0, -10.0];
+    s.enable_sleep = false;
+    s.materials.insert(
+        "grain".into(),
+        MaterialSpec {
+            density: Some(1.0),
+            friction: Some(0.6),
+            ..MaterialSpec::default()
+        },
+    );
+    let cols = n.div_ceil(RAIN_ROWS);
+    let half_width = rain_half_width(n);
+    let wall_top = 25.0f32;
+    let mut container = body(Some("container".into()), BodyKind::Static, [0.0, 0.0], 0.0, Vec::new());
+    for (center, half) in [
+        ([0.0f32, -1.0f32], [half_width + 1.0, 1.0f32]),
+        ([-half_width - 0.5, 0.5 * wall_top], [0.5, 0.5 * wall_top]),
+        ([half_width + 0.5, 0.5 * wall_top], [0.5, 0.5 * wall_top]),
+    ] {
+        container.shapes.push(ShapeSpec {
+            center: Some(center),
+            ..box_shape(half[0], half[1], None)
+        });
+    }
+    s.bodies.push(container);
+    // SplitMix64-style hash of the index: a fixed pseudo-random number in [−1, 1).
+    let jitter = |k: u64| {
+        let mut z = k.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 40) as f32 / (1u64 << 23) as f32 - 1.0
+    };
+    for k in 0..n {
+        let (row, col) = (k / cols, k % cols);
+        let shift = if row % 2 == 1 { 0.5 } else { 0.0 };
+        let x = -half_width + 0.25 + shift + col as f32 + 0.15 * jitter(2 * k as u64);
+        // Keep a turned box (reach ≤ 0.25 (cos 0.5 + sin 0.5) < 0.34 m) off the walls.
+        let x = x.clamp(-half_width + 0.35, half_width - 0.35);
+        let y = 1.0 + row as f32;
+        let (shape, angle) = if k % 3 == 2 {
+            (circle_shape(0.25, named("grain")), 0.0)
+        } else {
+            (box_shape(0.25, 0.25, named("grain")), 0.5 * jitter(2 * k as u64 + 1))
+        };
+        s.bodies.push(body(None, BodyKind::Dynamic, [x, y], angle, vec![shape]));
+    }
+    s
+}
+
+/// [`scaling_rain`] with 1 000 bodies (container 50 m wide).
+pub fn scaling_rain_1k() -> SceneFile {
+    scaling_rain(1000)
+}
+
 /// Box2D v3's pyramid of unit boxes (SCENES.md §2): `base` boxes in the bottom row; box
 /// (i, j), j = i…base−1, at x = 0.5 (i + 1) + (j − i) + `x_offset`, y = i + 0.5 + `base_y`.
 fn box2d_pyramid(s: &mut SceneFile, base: usize, x_offset: f32, base_y: f32) {
@@ -508,6 +680,54 @@ mod tests {
             let back = crate::format::parse(&text).expect("exported scene parses");
             assert_eq!(back, scene, "{}", entry.name);
         }
+    }
+}
+
+#[cfg(test)]
+mod benchmark_scene_tests {
+    use super::*;
+
+    #[test]
+    fn tumbler_benchmark_matches_scenes_md_but_for_the_kinematic_drum() {
+        let s = tumbler_benchmark();
+        assert_eq!((s.steps, s.gravity, s.enable_sleep), (750, [0.0, -10.0], true));
+        assert_eq!(s.bodies.len(), 1 + 45 * 45);
+        let drum = &s.bodies[0];
+        assert_eq!(drum.kind, BodyKind::Kinematic);
+        assert_eq!(drum.position, [0.0, 10.0]);
+        assert!((drum.angular_velocity - 0.436).abs() < 1e-3);
+        assert_eq!(drum.shapes.len(), 4);
+        assert_eq!(s.shape_material(&drum.shapes[0]).density, 50.0);
+        let last = s.bodies.last().expect("boxes");
+        assert_eq!(last.kind, BodyKind::Dynamic);
+        assert!((last.position[0] - (-9.0 + 0.4 * 44.0)).abs() < 1e-5);
+        assert!((last.position[1] - (1.0 + 0.4 * 44.0)).abs() < 1e-5);
+        let m = s.shape_material(&last.shapes[0]);
+        assert_eq!((m.density, m.friction_static, m.friction_dynamic), (1.0, 0.6, 0.6));
+        assert_eq!(last.shapes[0].half_extents, Some([0.125, 0.125]));
+    }
+
+    #[test]
+    fn scaling_rain_starts_inside_its_container_without_overlaps() {
+        for n in [1000, 4000, 1234] {
+            let s = scaling_rain(n);
+            assert!(s.validate().is_ok());
+            assert_eq!(s.bodies.len(), n + 1);
+            let hw = rain_half_width(n);
+            assert_eq!(hw, 0.5 * n.div_ceil(RAIN_ROWS) as f32);
+            let pos: Vec<[f32; 2]> = s.bodies[1..].iter().map(|b| b.position).collect();
+            // A body reaches at most 0.25 · (cos 0.5 + sin 0.5) < 0.34 m from its centre.
+            for p in &pos {
+                assert!(p[0].abs() <= hw - 0.345 && p[1] >= 1.0, "{p:?}");
+            }
+            for (k, a) in pos.iter().enumerate() {
+                for b in &pos[k + 1..] {
+                    let d = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
+                    assert!(d > 0.68, "{a:?} {b:?}");
+                }
+            }
+        }
+        assert_eq!(scaling_rain(1000), scaling_rain_1k());
     }
 }
 
