@@ -154,6 +154,8 @@ pub(crate) struct Body {
     /// How long [s] the body has been below its sleep threshold.
     pub sleep_time: f32,
     /// Largest distance from the centre of mass to any of its shapes' points [m].
+    /// Set by finalize when the solver produced a non-finite state (reported, then cleared).
+    pub non_finite: bool,
     pub max_extent: f32,
     pub shapes: Vec<ShapeId>,
     /// Indices of the contacts this body takes part in.
@@ -194,6 +196,7 @@ impl Body {
             awake: def.awake || def.body_type == BodyType::Static,
             sleep_time: 0.0,
             max_extent: 0.0,
+            non_finite: false,
             shapes: Vec::new(),
             contacts: Vec::new(),
             user_data: def.user_data,

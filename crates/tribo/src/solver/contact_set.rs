@@ -19,8 +19,8 @@
 
 use super::contact_solver::{
     build_constraint, end_substep_one, estimate, has_fresh_point, is_new_resting, record_approach, restitution_one,
-    solve_one, store_impulses, warm_start_one, ConstraintBodies, ContactConstraint, StepSoftness, MASS_RATIO_GROUP,
-    MAX_LOCAL_SWEEPS,
+    solve_one, store_impulses, warm_start_one, ConstraintBodies, ContactConstraint, ContactInput, StepSoftness,
+    MASS_RATIO_GROUP, MAX_LOCAL_SWEEPS,
 };
 use super::contact_wide::{self, WideCold, WideContact, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
@@ -42,6 +42,7 @@ enum Slot {
 pub(crate) struct Candidate {
     pub contact: u32,
     pub bodies: ConstraintBodies,
+    pub input: ContactInput,
 }
 
 /// A light body's constraints, solved again ⌈M/m⌉ times per relax pass.
@@ -92,13 +93,7 @@ fn dynamic_side(inv_mass: f32, inv_i: f32) -> bool {
 impl ContactSolver {
     /// Builds the step's constraints from `candidates` (in solve order); `contacts` is the
     /// world's contact list, `states` the awake bodies' solver states.
-    pub fn build(
-        &mut self,
-        ctx: &StepContext,
-        states: &States,
-        candidates: &[Candidate],
-        contacts: &[Option<Contact>],
-    ) {
+    pub fn build(&mut self, ctx: &StepContext, states: &States, candidates: &[Candidate]) {
         self.overflow.clear();
         self.fresh.clear();
         self.groups.clear();
@@ -171,12 +166,7 @@ impl ContactSolver {
                 }
             }
             let slot = if colour == OVERFLOW {
-                let Some(Some(c)) = contacts.get(cand.contact as usize) else {
-                    // Cannot happen (candidates come from the contact list).
-                    self.slots.push(Slot::Overflow(u32::MAX));
-                    continue;
-                };
-                let cc = build_constraint(cand.contact, c, b, self.up, &soft, ctx, states);
+                let cc = build_constraint(cand.contact, &cand.input, b, self.up, &soft, ctx, states);
                 if has_fresh_point(&cc) {
                     self.fresh.push(Slot::Overflow(self.overflow.len() as u32));
                 }
@@ -206,16 +196,10 @@ impl ContactSolver {
                 w.any_rolling = false;
                 cold.any_restitution = false;
                 for (l, &i) in lane_candidates[g].iter().enumerate() {
-                    let built = candidates.get(i as usize).and_then(|cand| {
-                        let c = contacts.get(cand.contact as usize)?.as_ref()?;
-                        Some((
-                            cand,
-                            build_constraint(cand.contact, c, &cand.bodies, up, &soft, ctx, states),
-                        ))
-                    });
-                    match built {
-                        Some((cand, cc)) => {
+                    match candidates.get(i as usize) {
+                        Some(cand) => {
                             let b = &cand.bodies;
+                            let cc = build_constraint(cand.contact, &cand.input, b, up, &soft, ctx, states);
                             let da = dynamic_side(b.inv_mass_a, b.inv_i_a);
                             let db = dynamic_side(b.inv_mass_b, b.inv_i_b);
                             contact_wide::pack(w, cold, l, &cc, da, db);

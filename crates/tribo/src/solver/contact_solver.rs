@@ -137,11 +137,73 @@ pub(crate) struct ConstraintBodies {
     pub center_b: Vec2,
 }
 
+/// What building a constraint reads of a contact, copied out in contact order (compact
+/// and contiguous, so the build in colour order does not chase 400-byte contact records
+/// across memory).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct ContactInput {
+    pub normal: Vec2,
+    pub count: usize,
+    pub points: [InputPoint; 2],
+    pub mu_s: f32,
+    pub mu_d: f32,
+    pub restitution: f32,
+    pub restitution_threshold: f32,
+    /// Rolling resistance × rolling radius [m].
+    pub rolling_resistance: f32,
+    pub tangent_speed: f32,
+    pub rolling_impulse: f32,
+}
+
+/// One manifold point and its carried-over state (see [`ContactInput`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct InputPoint {
+    pub point: Vec2,
+    pub separation: f32,
+    pub normal_impulse: f32,
+    pub tangent_impulse: f32,
+    pub preload: f32,
+    pub drift: f32,
+    pub stick: bool,
+    pub fresh: bool,
+}
+
+impl ContactInput {
+    pub fn new(c: &Contact) -> ContactInput {
+        let mut input = ContactInput {
+            normal: c.manifold.normal,
+            count: c.manifold.count.min(2),
+            points: [InputPoint::default(); 2],
+            mu_s: c.material.friction_static,
+            mu_d: c.material.friction_dynamic,
+            restitution: c.material.restitution,
+            restitution_threshold: c.material.restitution_threshold,
+            rolling_resistance: c.material.rolling_resistance * c.rolling_radius,
+            tangent_speed: c.material.tangent_speed,
+            rolling_impulse: c.rolling_impulse,
+        };
+        for i in 0..input.count {
+            let (mp, ps) = (&c.manifold.points[i], &c.points[i]);
+            input.points[i] = InputPoint {
+                point: mp.point,
+                separation: mp.separation,
+                normal_impulse: ps.normal_impulse,
+                tangent_impulse: ps.tangent_impulse,
+                preload: ps.preload,
+                drift: ps.drift,
+                stick: ps.state == FrictionState::Stick,
+                fresh: ps.fresh,
+            };
+        }
+        input
+    }
+}
+
 /// Builds the scalar constraint of one touching contact: anchors, masses, the 2×2 block,
 /// softness, and the friction state of new points (which needs the body velocities).
 pub(crate) fn build_constraint(
     contact_index: u32,
-    c: &Contact,
+    c: &ContactInput,
     bodies: &ConstraintBodies,
     up: Vec2,
     soft: &StepSoftness,
@@ -152,29 +214,25 @@ pub(crate) fn build_constraint(
         index_a: bodies.index_a,
         index_b: bodies.index_b,
         contact: contact_index,
-        normal: c.manifold.normal,
+        normal: c.normal,
         inv_mass_a: bodies.inv_mass_a,
         inv_i_a: bodies.inv_i_a,
         inv_mass_b: bodies.inv_mass_b,
         inv_i_b: bodies.inv_i_b,
-        mu_s: c.material.friction_static,
-        mu_d: c.material.friction_dynamic,
-        restitution: c.material.restitution,
-        restitution_threshold: c.material.restitution_threshold,
-        rolling_resistance: c.material.rolling_resistance * c.rolling_radius,
+        mu_s: c.mu_s,
+        mu_d: c.mu_d,
+        restitution: c.restitution,
+        restitution_threshold: c.restitution_threshold,
+        rolling_resistance: c.rolling_resistance,
         rolling_mass: 0.0,
         rolling_impulse: if ctx.warm_starting { c.rolling_impulse } else { 0.0 },
-        tangent_speed: c.material.tangent_speed,
+        tangent_speed: c.tangent_speed,
         k: [0.0; 3],
         inv_k: [0.0; 3],
         block: false,
         patch_tangent_mass: 0.0,
         kinetic_energy: 0.0,
-        height: if c.manifold.count > 0 {
-            c.manifold.points[0].point.dot(up)
-        } else {
-            0.0
-        },
+        height: if c.count > 0 { c.points[0].point.dot(up) } else { 0.0 },
         split: {
             let sum = bodies.inv_mass_a + bodies.inv_mass_b;
             if sum > 0.0 {
@@ -183,7 +241,7 @@ pub(crate) fn build_constraint(
                 0.5
             }
         },
-        count: c.manifold.count,
+        count: c.count,
         points: [ConstraintPoint::default(); 2],
     };
     let k_roll = bodies.inv_i_a + bodies.inv_i_b;
@@ -202,19 +260,14 @@ pub(crate) fn build_constraint(
         soft.contact
     };
     for i in 0..cc.count {
-        let mp = &c.manifold.points[i];
         let ps = &c.points[i];
-        let r_a = mp.point - bodies.center_a;
-        let r_b = mp.point - bodies.center_b;
+        let r_a = ps.point - bodies.center_a;
+        let r_b = ps.point - bodies.center_b;
         let cp = &mut cc.points[i];
         cp.r_a = r_a;
         cp.r_b = r_b;
-        cp.base_separation = mp.separation;
-        cp.base_drift = if ps.state == FrictionState::Stick && !ps.fresh {
-            ps.drift
-        } else {
-            0.0
-        };
+        cp.base_separation = ps.separation;
+        cp.base_drift = if ps.stick && !ps.fresh { ps.drift } else { 0.0 };
         cp.normal_mass = inv_or_zero(effective_mass_inv(&masses, r_a, r_b, n));
         cp.tangent_mass = inv_or_zero(effective_mass_inv(&masses, r_a, r_b, t));
         if ctx.warm_starting {
@@ -222,7 +275,7 @@ pub(crate) fn build_constraint(
             cp.tangent_impulse = ps.tangent_impulse;
             cp.preload = ps.preload;
         }
-        cp.stick = ps.state == FrictionState::Stick;
+        cp.stick = ps.stick;
         cp.fresh = ps.fresh;
         cp.soft = point_soft;
         if cp.fresh {

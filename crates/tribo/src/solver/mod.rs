@@ -214,6 +214,17 @@ pub(crate) fn for_each_chunk_mut<T: Send>(
     }
 }
 
+/// `items.iter().map(f).collect()`, split between the pool's threads when `parallel`
+/// (the output keeps the input's order).
+pub(crate) fn map_collect<T: Sync, U: Send>(parallel: bool, items: &[T], f: impl Fn(&T) -> U + Sync) -> Vec<U> {
+    if parallel {
+        use rayon::prelude::*;
+        items.par_iter().with_min_len(256).map(|x| f(x)).collect()
+    } else {
+        items.iter().map(f).collect()
+    }
+}
+
 /// Like [`for_each_mut`] over `0..n` with shared access only.
 pub(crate) fn for_each_index(parallel: bool, n: usize, min_len: usize, f: impl Fn(usize) + Sync) {
     if parallel {

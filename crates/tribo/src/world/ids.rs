@@ -108,6 +108,19 @@ impl<T> Arena<T> {
         self.slots.get_mut(index as usize).and_then(|s| s.value.as_mut())
     }
 
+    /// Calls `f(index, value)` for every live value, split between the pool's threads when
+    /// `parallel` (each call may only touch its own value).
+    pub fn for_each_live_mut(&mut self, parallel: bool, min_len: usize, f: impl Fn(u32, &mut T) + Sync)
+    where
+        T: Send,
+    {
+        crate::solver::for_each_mut(parallel, &mut self.slots, min_len, |i, slot| {
+            if let Some(v) = slot.value.as_mut() {
+                f(i as u32, v);
+            }
+        });
+    }
+
     /// The generation currently stored at a slot.
     #[inline]
     pub fn generation(&self, index: u32) -> u32 {

@@ -16,8 +16,8 @@ use crate::error::{Error, Result};
 use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::Candidate;
-use crate::solver::contact_solver::ConstraintBodies;
-use crate::solver::{for_each_mut, solve_step, BodySim, BodyState, SharedState, StepContext};
+use crate::solver::contact_solver::{ConstraintBodies, ContactInput};
+use crate::solver::{for_each_mut, map_collect, solve_step, BodySim, BodyState, SharedState, StepContext};
 use crate::world::Arena;
 use crate::world::BodyId;
 
@@ -57,7 +57,7 @@ impl World {
         let ctx = self.step_context(dt, parallel);
         self.solve(&ctx);
         lap.lap();
-        self.finalize(dt);
+        self.finalize(dt, parallel);
         self.profile.finalize = lap.lap();
         self.update_sleep(dt);
         self.profile.sleep = lap.lap();
@@ -359,43 +359,51 @@ impl World {
         // bodies, so the ground has the last word in each pass (as Box2D's colouring does).
         let mut candidates = core::mem::take(&mut self.candidates);
         candidates.clear();
-        for pass_static in [false, true] {
-            for &ci in &self.touching_contacts {
-                let Some(Some(c)) = self.contacts.get(ci as usize) else {
-                    continue;
-                };
-                if !c.touching {
-                    continue;
+        let bodies = &self.bodies;
+        let contacts = &self.contacts;
+        let found: Vec<Option<(bool, Candidate)>> = map_collect(ctx.parallel, &self.touching_contacts, |&ci| {
+            let c = contacts.get(ci as usize)?.as_ref()?;
+            if !c.touching {
+                return None;
+            }
+            let (ba, bb) = (bodies.at(c.body_a)?, bodies.at(c.body_b)?);
+            let awake_dynamic = (ba.awake && ba.is_dynamic()) || (bb.awake && bb.is_dynamic());
+            if !awake_dynamic {
+                return None;
+            }
+            let has_static = ba.solver_index == 0 || bb.solver_index == 0;
+            let side = |b: &Body| {
+                if b.solver_index == 0 {
+                    (0.0, 0.0)
+                } else {
+                    (b.inv_mass, b.inv_inertia)
                 }
-                let (Some(ba), Some(bb)) = (self.bodies.at(c.body_a), self.bodies.at(c.body_b)) else {
-                    continue;
-                };
-                let awake_dynamic = (ba.awake && ba.is_dynamic()) || (bb.awake && bb.is_dynamic());
-                if !awake_dynamic {
-                    continue;
-                }
-                let has_static = ba.solver_index == 0 || bb.solver_index == 0;
-                if has_static != pass_static {
-                    continue;
-                }
-                candidates.push(Candidate {
+            };
+            let ((inv_mass_a, inv_i_a), (inv_mass_b, inv_i_b)) = (side(ba), side(bb));
+            Some((
+                has_static,
+                Candidate {
                     contact: ci,
+                    input: ContactInput::new(c),
                     bodies: ConstraintBodies {
                         index_a: ba.solver_index,
                         index_b: bb.solver_index,
-                        inv_mass_a: if ba.solver_index == 0 { 0.0 } else { ba.inv_mass },
-                        inv_i_a: if ba.solver_index == 0 { 0.0 } else { ba.inv_inertia },
-                        inv_mass_b: if bb.solver_index == 0 { 0.0 } else { bb.inv_mass },
-                        inv_i_b: if bb.solver_index == 0 { 0.0 } else { bb.inv_inertia },
+                        inv_mass_a,
+                        inv_i_a,
+                        inv_mass_b,
+                        inv_i_b,
                         center_a: ba.center,
                         center_b: bb.center,
                     },
-                });
-            }
+                },
+            ))
+        });
+        for pass_static in [false, true] {
+            candidates.extend(found.iter().flatten().filter(|f| f.0 == pass_static).map(|f| f.1));
         }
         let mut solver = core::mem::take(&mut self.contact_solver);
         solver.up = (-g).normalize_or_zero();
-        solver.build(ctx, &self.states, &candidates, &self.contacts);
+        solver.build(ctx, &self.states, &candidates);
         self.candidates = candidates;
         self.profile.solver_setup = lap.lap();
         solve_step(ctx, &self.sims, &self.states, &mut solver, &mut self.profile);
@@ -406,26 +414,25 @@ impl World {
     }
 
     /// Writes the solver's motion back to the bodies, refreshes fat boxes and sleep timers.
-    fn finalize(&mut self, dt: f32) {
-        for k in 1..self.states.len() {
-            let s = self.states[k].load();
-            let bi = self.sims[k].body;
-            let Some(b) = self.bodies.at_mut(bi) else { continue };
+    fn finalize(&mut self, dt: f32, parallel: bool) {
+        // Poses and sleep timers, body by body (in parallel: each body writes itself).
+        let (states, sleep_on) = (&self.states, self.def.enable_sleep);
+        self.bodies.for_each_live_mut(parallel, BODY_CHUNK, |_, b| {
+            if b.solver_index == 0 {
+                return;
+            }
+            let s = states[b.solver_index as usize].load();
             b.force = Vec2::ZERO;
             b.torque = 0.0;
             let finite =
                 s.v.is_finite() && s.w.is_finite() && s.dp.is_finite() && s.dq.c.is_finite() && s.dq.s.is_finite();
             if !finite {
                 // NaN born inside the simulation: freeze the body at its last good pose
-                // and report it rather than spreading the NaN.
+                // and report it (below) rather than spreading the NaN.
                 b.v = Vec2::ZERO;
                 b.w = 0.0;
-                let id = BodyId {
-                    index: bi,
-                    generation: self.bodies.generation(bi),
-                };
-                self.non_finite.push(id);
-                continue;
+                b.non_finite = true;
+                return;
             }
             b.v = s.v;
             b.w = s.w;
@@ -440,7 +447,7 @@ impl World {
             };
             b.xf.p = b.center - b.xf.q.rotate(b.local_center);
             // Sleep timer (Box2D's metric: |v| + |ω|·extent against the threshold).
-            if self.def.enable_sleep && b.enable_sleep && b.body_type == BodyType::Dynamic {
+            if sleep_on && b.enable_sleep && b.body_type == BodyType::Dynamic {
                 let speed = b.v.length() + b.w.abs() * b.max_extent;
                 if speed > b.sleep_threshold {
                     b.sleep_time = 0.0;
@@ -449,6 +456,20 @@ impl World {
                 }
             } else {
                 b.sleep_time = 0.0;
+            }
+        });
+        // Fat boxes and the trees, in solver order (the trees are shared).
+        for k in 1..self.states.len() {
+            let bi = self.sims[k].body;
+            let Some(b) = self.bodies.at_mut(bi) else { continue };
+            if b.non_finite {
+                b.non_finite = false;
+                let id = BodyId {
+                    index: bi,
+                    generation: self.bodies.generation(bi),
+                };
+                self.non_finite.push(id);
+                continue;
             }
             self.refresh_body_proxies(bi, dt);
         }
@@ -528,6 +549,9 @@ impl World {
         &self.non_finite
     }
 }
+
+/// Bodies per parallel chunk of finalize.
+const BODY_CHUNK: usize = 256;
 
 /// Contacts per parallel chunk of the narrow phase and the impulse store.
 const CONTACT_CHUNK: usize = 256;
