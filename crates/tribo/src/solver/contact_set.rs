@@ -24,7 +24,7 @@ use super::contact_solver::{
 };
 use super::contact_wide::{self, WideCold, WideContact, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
-use super::{for_each_chunk_mut, for_each_mut, for_each_mut2, ConstraintSet, States, StepContext};
+use super::{for_each_chunk_mut, for_each_mut2, ConstraintSet, StateCell, StateRead, StepContext};
 use crate::collision::contact::Contact;
 use crate::math::Vec2;
 
@@ -93,7 +93,7 @@ fn dynamic_side(inv_mass: f32, inv_i: f32) -> bool {
 impl ContactSolver {
     /// Builds the step's constraints from `candidates` (in solve order); `contacts` is the
     /// world's contact list, `states` the awake bodies' solver states.
-    pub fn build(&mut self, ctx: &StepContext, states: &States, candidates: &[Candidate]) {
+    pub fn build<S: StateRead + Sync>(&mut self, ctx: &StepContext, states: &[S], candidates: &[Candidate]) {
         self.overflow.clear();
         self.fresh.clear();
         self.groups.clear();
@@ -283,10 +283,10 @@ impl ContactSolver {
     /// Writes every constraint's impulses and friction state back into its contact
     /// (`contacts` is the world's contact list), split between the worker threads by
     /// contact (each writes only its own contact).
-    pub fn store(
+    pub fn store<S: StateRead + Sync>(
         &mut self,
         ctx: &StepContext,
-        states: &States,
+        states: &[S],
         candidates: &[Candidate],
         contacts: &mut [Option<Contact>],
     ) {
@@ -331,7 +331,7 @@ impl ConstraintSet for ContactSolver {
         !self.fresh.is_empty()
     }
 
-    fn estimate_new_contacts(&mut self, ctx: &StepContext, trial: &States) -> bool {
+    fn estimate_new_contacts<S: StateCell>(&mut self, ctx: &StepContext, trial: &[S]) -> bool {
         let mut subset = Vec::new();
         let mut slots = Vec::new();
         for &slot in &self.fresh {
@@ -357,19 +357,19 @@ impl ConstraintSet for ContactSolver {
         true
     }
 
-    fn warm_start(&mut self, ctx: &StepContext, states: &States) {
+    fn warm_start<S: StateCell>(&mut self, _ctx: &StepContext, states: &[S]) {
         for cc in &mut self.overflow {
             warm_start_one(cc, states);
         }
         for &(start, end) in &self.ranges {
             let colour = &mut self.wide[start as usize..end as usize];
-            for_each_mut(ctx.parallel, colour, GROUP_CHUNK, |_, w| {
+            S::for_each_mut(states, colour, GROUP_CHUNK, |_, w, states| {
                 contact_wide::warm_start(w, states)
             });
         }
     }
 
-    fn solve(&mut self, ctx: &StepContext, states: &States, use_bias: bool, elapsed: f32) {
+    fn solve<S: StateCell>(&mut self, ctx: &StepContext, states: &[S], use_bias: bool, elapsed: f32) {
         for cc in &mut self.overflow {
             solve_one(cc, states, ctx, use_bias, elapsed);
         }
@@ -377,12 +377,12 @@ impl ConstraintSet for ContactSolver {
         for &(start, end) in &self.ranges {
             let colour = &mut self.wide[start as usize..end as usize];
             if use_bias {
-                for_each_mut(ctx.parallel, colour, GROUP_CHUNK, |_, w| {
-                    contact_wide::solve::<true>(w, states, ctx, elapsed)
+                S::for_each_mut(states, colour, GROUP_CHUNK, |_, w, states| {
+                    contact_wide::solve::<true, S>(w, states, ctx, elapsed)
                 });
             } else {
-                for_each_mut(ctx.parallel, colour, GROUP_CHUNK, |_, w| {
-                    contact_wide::solve::<false>(w, states, ctx, elapsed)
+                S::for_each_mut(states, colour, GROUP_CHUNK, |_, w, states| {
+                    contact_wide::solve::<false, S>(w, states, ctx, elapsed)
                 });
             }
         }
@@ -421,7 +421,7 @@ impl ConstraintSet for ContactSolver {
         }
     }
 
-    fn restitution(&mut self, states: &States) {
+    fn restitution<S: StateCell>(&mut self, states: &[S]) {
         for cc in &mut self.overflow {
             restitution_one(cc, states);
         }

@@ -52,7 +52,7 @@
 //! The two normal rows of a 2-point manifold are solved together (a 2×2 LCP, Box2D v2.4's
 //! block solver in soft form), so one iteration is exact within the manifold.
 
-use super::{BodyState, Softness, States, StepContext};
+use super::{BodyState, Softness, StateCell, StateRead, StepContext};
 use crate::collision::contact::{Contact, FrictionState};
 use crate::math::Vec2;
 
@@ -201,14 +201,14 @@ impl ContactInput {
 
 /// Builds the scalar constraint of one touching contact: anchors, masses, the 2×2 block,
 /// softness, and the friction state of new points (which needs the body velocities).
-pub(crate) fn build_constraint(
+pub(crate) fn build_constraint<S: StateRead>(
     contact_index: u32,
     c: &ContactInput,
     bodies: &ConstraintBodies,
     up: Vec2,
     soft: &StepSoftness,
     ctx: &StepContext,
-    states: &States,
+    states: &[S],
 ) -> ContactConstraint {
     let mut cc = ContactConstraint {
         index_a: bodies.index_a,
@@ -331,7 +331,7 @@ pub(crate) fn has_fresh_point(cc: &ContactConstraint) -> bool {
 }
 
 /// Records each point's normal velocity under `states` (the approach speed of new points).
-pub(crate) fn record_approach(cc: &mut ContactConstraint, states: &States) {
+pub(crate) fn record_approach<S: StateRead>(cc: &mut ContactConstraint, states: &[S]) {
     let (a, b) = load(states, cc.index_a, cc.index_b);
     for i in 0..cc.count {
         let (r_a, r_b) = (cc.points[i].r_a, cc.points[i].r_b);
@@ -352,7 +352,7 @@ pub(crate) fn is_new_resting(cc: &ContactConstraint) -> bool {
 /// against `trial`, the states after one substep of forces: first the top-down statics
 /// pass ([`statics_estimate`]), then sequential sweeps from the top down until the
 /// normal impulses settle. Sets each point's preload to its estimate.
-pub(crate) fn estimate(subset: &mut [ContactConstraint], up: Vec2, ctx: &StepContext, trial: &States) {
+pub(crate) fn estimate<S: StateCell>(subset: &mut [ContactConstraint], up: Vec2, ctx: &StepContext, trial: &[S]) {
     if subset.is_empty() {
         return;
     }
@@ -402,7 +402,7 @@ pub(crate) fn estimate(subset: &mut [ContactConstraint], up: Vec2, ctx: &StepCon
 /// for stacks and pyramids (statically determinate per body) and a good start for piles;
 /// the rigid sweeps that follow correct it. Sequential sweeps alone need on the order of
 /// N² sweeps to carry the weight of an N-high stack to the ground.
-pub(crate) fn statics_estimate(subset: &mut [ContactConstraint], up: Vec2, trial: &States) {
+pub(crate) fn statics_estimate<S: StateCell>(subset: &mut [ContactConstraint], up: Vec2, trial: &[S]) {
     if up == Vec2::ZERO {
         return;
     }
@@ -451,7 +451,7 @@ pub(crate) fn statics_estimate(subset: &mut [ContactConstraint], up: Vec2, trial
             subset[i0].inv_mass_a
         };
         // Own weight: the impulse that stops this substep's fall, acting at the centre.
-        let fall = (-trial[upper as usize].load().v.dot(up)).max(0.0);
+        let fall = (-trial[upper as usize].get().v.dot(up)).max(0.0);
         let own = fall / inv_m;
         let w_total = own + carried[upper as usize];
         if w_total <= 0.0 {
@@ -728,23 +728,23 @@ fn anchor_displacement(a: &BodyState, b: &BodyState, r_a: Vec2, r_b: Vec2) -> Ve
 
 /// Reads two body states; index 0 is the shared static body, never written.
 #[inline]
-fn load(states: &States, ia: u32, ib: u32) -> (BodyState, BodyState) {
-    (states[ia as usize].load(), states[ib as usize].load())
+fn load<S: StateRead>(states: &[S], ia: u32, ib: u32) -> (BodyState, BodyState) {
+    (states[ia as usize].get(), states[ib as usize].get())
 }
 
 #[inline]
-fn store(states: &States, ia: u32, ib: u32, a: BodyState, b: BodyState) {
+fn store<S: StateCell>(states: &[S], ia: u32, ib: u32, a: BodyState, b: BodyState) {
     if ia != 0 {
-        states[ia as usize].store(a);
+        states[ia as usize].set(a);
     }
     if ib != 0 {
-        states[ib as usize].store(b);
+        states[ib as usize].set(b);
     }
 }
 
 /// Restitution for one constraint (after all substeps): points that approached faster
 /// than the threshold and took load bounce with `e` times their approach speed.
-pub(crate) fn restitution_one(cc: &mut ContactConstraint, states: &States) {
+pub(crate) fn restitution_one<S: StateCell>(cc: &mut ContactConstraint, states: &[S]) {
     if cc.restitution == 0.0 {
         return;
     }
@@ -821,7 +821,7 @@ pub(crate) fn restitution_one(cc: &mut ContactConstraint, states: &States) {
 
 /// Re-applies one constraint's accumulated impulses at the start of a substep, after
 /// recording its points' normal velocities (restitution's impact speed).
-pub(crate) fn warm_start_one(cc: &mut ContactConstraint, states: &States) {
+pub(crate) fn warm_start_one<S: StateCell>(cc: &mut ContactConstraint, states: &[S]) {
     let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
     let n = cc.normal;
     let t = n.right_perp();
@@ -839,7 +839,13 @@ pub(crate) fn warm_start_one(cc: &mut ContactConstraint, states: &States) {
 }
 
 /// One pass over one contact: normal rows, friction rows, rolling resistance.
-pub(crate) fn solve_one(cc: &mut ContactConstraint, states: &States, ctx: &StepContext, use_bias: bool, elapsed: f32) {
+pub(crate) fn solve_one<S: StateCell>(
+    cc: &mut ContactConstraint,
+    states: &[S],
+    ctx: &StepContext,
+    use_bias: bool,
+    elapsed: f32,
+) {
     let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
     solve_normals(cc, &mut a, &mut b, ctx, use_bias);
     if cc.points[..cc.count].iter().any(|p| p.normal_impulse > 0.0) {
@@ -984,7 +990,12 @@ fn solve_rolling(cc: &mut ContactConstraint, a: &mut BodyState, b: &mut BodyStat
 
 /// Writes impulses back into the contact and runs the stick/slip transitions
 /// (store stage). `states` are the end-of-step states.
-pub(crate) fn store_impulses(cc: &ContactConstraint, contact: &mut Contact, states: &States, ctx: &StepContext) {
+pub(crate) fn store_impulses<S: StateRead>(
+    cc: &ContactConstraint,
+    contact: &mut Contact,
+    states: &[S],
+    ctx: &StepContext,
+) {
     let (a, b) = load(states, cc.index_a, cc.index_b);
     let t = cc.normal.right_perp();
     contact.rolling_impulse = cc.rolling_impulse;

@@ -26,7 +26,7 @@
 use super::contact_solver::{ConstraintPoint, ContactConstraint};
 use super::wide::{F4, LANES, M4, V4};
 use super::Softness;
-use super::{States, StepContext};
+use super::{StateCell, StateRead, StepContext};
 use crate::math::Vec2;
 
 /// Number of colours (Box2D v3 uses 24, the last for overflow).
@@ -130,7 +130,7 @@ struct WideBody {
 }
 
 #[inline(always)]
-fn gather(states: &States, idx: &[u32; LANES]) -> WideBody {
+fn gather<S: StateRead>(states: &[S], idx: &[u32; LANES]) -> WideBody {
     let mut b = WideBody {
         v: V4::default(),
         w: F4::ZERO,
@@ -139,7 +139,7 @@ fn gather(states: &States, idx: &[u32; LANES]) -> WideBody {
         dq_s: F4::ZERO,
     };
     for l in 0..LANES {
-        let s = states[idx[l] as usize].load();
+        let s = states[idx[l] as usize].get();
         b.v.x.0[l] = s.v.x;
         b.v.y.0[l] = s.v.y;
         b.w.0[l] = s.w;
@@ -152,10 +152,10 @@ fn gather(states: &States, idx: &[u32; LANES]) -> WideBody {
 }
 
 #[inline(always)]
-fn scatter(states: &States, idx: &[u32; LANES], write: &[bool; LANES], b: &WideBody) {
+fn scatter<S: StateCell>(states: &[S], idx: &[u32; LANES], write: &[bool; LANES], b: &WideBody) {
     for l in 0..LANES {
         if write[l] {
-            states[idx[l] as usize].store_velocity(Vec2::new(b.v.x.0[l], b.v.y.0[l]), b.w.0[l], b.touched.0[l]);
+            states[idx[l] as usize].set_velocity(Vec2::new(b.v.x.0[l], b.v.y.0[l]), b.w.0[l], b.touched.0[l]);
         }
     }
 }
@@ -198,7 +198,7 @@ fn anchor_displacement(a: &WideBody, b: &WideBody, d: V4, r_a: V4, r_b: V4) -> V
 
 /// Re-applies the accumulated impulses at the start of a substep and records each point's
 /// normal velocity before them (restitution's impact speed).
-pub(crate) fn warm_start(c: &mut WideContact, states: &States) {
+pub(crate) fn warm_start<S: StateCell>(c: &mut WideContact, states: &[S]) {
     let mut a = gather(states, &c.index_a);
     let mut b = gather(states, &c.index_b);
     let d = b.dp - a.dp;
@@ -226,7 +226,12 @@ pub(crate) fn warm_start(c: &mut WideContact, states: &States) {
 
 /// One pass over four constraints: normal rows (block or sequential), the friction row,
 /// rolling resistance in the relax pass.
-pub(crate) fn solve<const USE_BIAS: bool>(c: &mut WideContact, states: &States, ctx: &StepContext, elapsed: f32) {
+pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
+    c: &mut WideContact,
+    states: &[S],
+    ctx: &StepContext,
+    elapsed: f32,
+) {
     let mut a = gather(states, &c.index_a);
     let mut b = gather(states, &c.index_b);
     let d = b.dp - a.dp;

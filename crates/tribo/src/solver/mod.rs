@@ -53,8 +53,111 @@ pub(crate) struct BodyState {
 #[repr(align(32))]
 pub(crate) struct SharedState([AtomicU64; 4]);
 
-/// The solver's body states (index 0: every static body).
-pub(crate) type States = [SharedState];
+/// How the solver reads and writes body states, and how it splits work: one
+/// implementation per step mode, so a single-threaded step works on plain states
+/// ([`Cell`]s over the world's `BodyState`s, no atomics) and a multi-threaded one on
+/// [`SharedState`]s (relaxed atomics, work split between the pool's threads). The solver
+/// code is generic over it: the physics is written once.
+pub(crate) trait StateRead {
+    fn get(&self) -> BodyState;
+}
+
+impl StateRead for BodyState {
+    #[inline(always)]
+    fn get(&self) -> BodyState {
+        *self
+    }
+}
+
+impl StateRead for core::cell::Cell<BodyState> {
+    #[inline(always)]
+    fn get(&self) -> BodyState {
+        core::cell::Cell::get(self)
+    }
+}
+
+impl StateRead for SharedState {
+    #[inline(always)]
+    fn get(&self) -> BodyState {
+        self.load()
+    }
+}
+
+/// [`StateRead`] plus writing, and the work split that goes with the storage.
+pub(crate) trait StateCell: StateRead + Clone + Send {
+    fn set(&self, s: BodyState);
+    /// Writes only what a constraint pass changes.
+    fn set_velocity(&self, v: Vec2, w: f32, touched: f32);
+    /// Calls `f(i, &mut items[i], states)` for every item; split between threads for
+    /// shared states (chunks of at least `min_len`). `f` may only write its item and the
+    /// states of bodies no other item touches.
+    fn for_each_mut<T: Send>(
+        states: &[Self],
+        items: &mut [T],
+        min_len: usize,
+        f: impl Fn(usize, &mut T, &[Self]) + Sync + Send,
+    );
+    /// Calls `f(i, states)` for `i` in `0..n` (split between threads for shared states).
+    fn for_each_index(states: &[Self], n: usize, min_len: usize, f: impl Fn(usize, &[Self]) + Sync + Send);
+}
+
+impl StateCell for core::cell::Cell<BodyState> {
+    #[inline(always)]
+    fn set(&self, s: BodyState) {
+        core::cell::Cell::set(self, s);
+    }
+    #[inline(always)]
+    fn set_velocity(&self, v: Vec2, w: f32, touched: f32) {
+        let mut s = core::cell::Cell::get(self);
+        s.v = v;
+        s.w = w;
+        s.touched = touched;
+        core::cell::Cell::set(self, s);
+    }
+    fn for_each_mut<T: Send>(
+        states: &[Self],
+        items: &mut [T],
+        _min_len: usize,
+        f: impl Fn(usize, &mut T, &[Self]) + Sync + Send,
+    ) {
+        for (i, x) in items.iter_mut().enumerate() {
+            f(i, x, states);
+        }
+    }
+    fn for_each_index(states: &[Self], n: usize, _min_len: usize, f: impl Fn(usize, &[Self]) + Sync + Send) {
+        for i in 0..n {
+            f(i, states);
+        }
+    }
+}
+
+impl StateCell for SharedState {
+    #[inline(always)]
+    fn set(&self, s: BodyState) {
+        self.store(s);
+    }
+    #[inline(always)]
+    fn set_velocity(&self, v: Vec2, w: f32, touched: f32) {
+        self.store_velocity(v, w, touched);
+    }
+    fn for_each_mut<T: Send>(
+        states: &[Self],
+        items: &mut [T],
+        min_len: usize,
+        f: impl Fn(usize, &mut T, &[Self]) + Sync + Send,
+    ) {
+        use rayon::prelude::*;
+        items
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(min_len)
+            .for_each(|(i, x)| f(i, x, states));
+    }
+    fn for_each_index(states: &[Self], n: usize, min_len: usize, f: impl Fn(usize, &[Self]) + Sync + Send) {
+        use rayon::prelude::*;
+        (0..n).into_par_iter().with_min_len(min_len).for_each(|i| f(i, states));
+    }
+}
 
 #[inline(always)]
 fn pack2(a: f32, b: f32) -> u64 {
@@ -225,16 +328,6 @@ pub(crate) fn map_collect<T: Sync, U: Send>(parallel: bool, items: &[T], f: impl
     }
 }
 
-/// Like [`for_each_mut`] over `0..n` with shared access only.
-pub(crate) fn for_each_index(parallel: bool, n: usize, min_len: usize, f: impl Fn(usize) + Sync) {
-    if parallel {
-        use rayon::prelude::*;
-        (0..n).into_par_iter().with_min_len(min_len).for_each(|i| f(i));
-    } else {
-        (0..n).for_each(f);
-    }
-}
-
 /// A family of constraints solved by the step (contacts now; joints later). The set is
 /// built before the step's stages run.
 pub(crate) trait ConstraintSet {
@@ -243,23 +336,23 @@ pub(crate) trait ConstraintSet {
     /// Estimates warm-start impulses for constraints that begin at rest (no history):
     /// rigid iterations against `trial`, the states after one substep of forces. Returns
     /// whether any constraint was estimated. The trial velocities are thrown away.
-    fn estimate_new_contacts(&mut self, ctx: &StepContext, trial: &States) -> bool;
+    fn estimate_new_contacts<C: StateCell>(&mut self, ctx: &StepContext, trial: &[C]) -> bool;
     /// Re-applies the accumulated impulses at the start of a substep.
-    fn warm_start(&mut self, ctx: &StepContext, states: &States);
+    fn warm_start<C: StateCell>(&mut self, ctx: &StepContext, states: &[C]);
     /// One sequential-impulse pass; `use_bias` adds the soft position correction.
-    fn solve(&mut self, ctx: &StepContext, states: &States, use_bias: bool, elapsed: f32);
+    fn solve<C: StateCell>(&mut self, ctx: &StepContext, states: &[C], use_bias: bool, elapsed: f32);
     /// Accumulates what a substep applied (after its relax pass).
     fn end_substep(&mut self);
     /// Restitution pass after all substeps.
-    fn restitution(&mut self, states: &States);
+    fn restitution<C: StateCell>(&mut self, states: &[C]);
 }
 
 /// Runs the stages of one step over the awake bodies and a constraint set, timing each
 /// stage into `profile`.
-pub(crate) fn solve_step<C: ConstraintSet>(
+pub(crate) fn solve_step<S: StateCell, C: ConstraintSet>(
     ctx: &StepContext,
     sims: &[BodySim],
-    states: &States,
+    states: &[S],
     constraints: &mut C,
     profile: &mut Profile,
 ) {
@@ -305,20 +398,20 @@ pub(crate) fn solve_step<C: ConstraintSet>(
 const BODY_CHUNK: usize = 512;
 
 /// v ← (v + h·a) / (1 + h·c): explicit forces, Padé damping (Box2D v3).
-fn integrate_velocities(ctx: &StepContext, sims: &[BodySim], states: &States) {
+fn integrate_velocities<S: StateCell>(ctx: &StepContext, sims: &[BodySim], states: &[S]) {
     let h = ctx.h;
     // Index 0 is the shared static body: it never moves.
-    for_each_index(ctx.parallel, sims.len(), BODY_CHUNK, |k| {
+    S::for_each_index(states, sims.len(), BODY_CHUNK, |k, states| {
         if k == 0 {
             return;
         }
         let (sim, state) = (&sims[k], &states[k]);
-        let s = state.load();
+        let s = state.get();
         let lin = 1.0 / (1.0 + h * sim.linear_damping);
         let ang = 1.0 / (1.0 + h * sim.angular_damping);
         let v = (s.v + h * sim.linear_accel) * lin;
         let w = (s.w + h * sim.angular_accel) * ang;
-        state.store_velocity(v, w, 0.0);
+        state.set_velocity(v, w, 0.0);
     });
 }
 
@@ -328,18 +421,18 @@ fn integrate_velocities(ctx: &StepContext, sims: &[BodySim], states: &States) {
 /// the exact displacement under the constant acceleration a of gravity and applied forces
 /// (plain symplectic Euler overshoots by ½h²a per substep, which makes a dropped ball hit
 /// slower and bounce lower than e²h by about (1 + 1/e)·g·h/v).
-fn integrate_positions(ctx: &StepContext, sims: &[BodySim], states: &States) {
+fn integrate_positions<S: StateCell>(ctx: &StepContext, sims: &[BodySim], states: &[S]) {
     let h = ctx.h;
     // Rotation per substep is limited to 0.25π per full step, as in Box2D, so the
     // first-order rotation update stays accurate.
     let max_w = 0.25 * core::f32::consts::PI / ctx.dt;
     let max_v2 = ctx.max_linear_speed * ctx.max_linear_speed;
-    for_each_index(ctx.parallel, sims.len(), BODY_CHUNK, |k| {
+    S::for_each_index(states, sims.len(), BODY_CHUNK, |k, states| {
         if k == 0 {
             return;
         }
         let (sim, state) = (&sims[k], &states[k]);
-        let mut s = state.load();
+        let mut s = state.get();
         if s.v.length_squared() > max_v2 {
             s.v = s.v * (ctx.max_linear_speed / s.v.length());
         }
@@ -351,6 +444,6 @@ fn integrate_positions(ctx: &StepContext, sims: &[BodySim], states: &States) {
             h * s.v
         };
         s.dq = s.dq.integrate(h * s.w);
-        state.store(s);
+        state.set(s);
     });
 }

@@ -27,7 +27,7 @@ use crate::error::{check_finite, check_non_negative, check_positive, check_vec, 
 use crate::geometry::{Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Aabb, Transform, Vec2};
 use crate::solver::contact_set::{Candidate, ContactSolver};
-use crate::solver::{BodySim, SharedState};
+use crate::solver::{BodySim, BodyState};
 
 /// World settings. Every field has a default (listed on the field) that matches Box2D v3
 /// where Box2D has the same setting, so scenes port.
@@ -122,7 +122,7 @@ pub struct World {
     /// Bodies whose state became non-finite in the last step (frozen and reported).
     pub(crate) non_finite: Vec<BodyId>,
     // Scratch buffers reused every step (no per-step allocation once warm).
-    pub(crate) states: Vec<SharedState>,
+    pub(crate) states: Vec<BodyState>,
     pub(crate) sims: Vec<BodySim>,
     pub(crate) contact_solver: ContactSolver,
     pub(crate) candidates: Vec<Candidate>,

@@ -323,7 +323,7 @@ impl World {
         let g = self.def.gravity;
         self.states.clear();
         self.sims.clear();
-        self.states.push(SharedState::new(BodyState::default())); // index 0: every static body
+        self.states.push(BodyState::default()); // index 0: every static body
         self.sims.push(BodySim::default());
         let capacity = self.bodies.capacity();
         for bi in 0..capacity as u32 {
@@ -333,13 +333,13 @@ impl World {
                 continue;
             }
             b.solver_index = self.states.len() as u32;
-            self.states.push(SharedState::new(BodyState {
+            self.states.push(BodyState {
                 v: b.v,
                 w: b.w,
                 touched: 0.0,
                 dp: Vec2::ZERO,
                 dq: Rot::IDENTITY,
-            }));
+            });
             let dynamic = b.body_type == BodyType::Dynamic;
             let force = b.force + b.constant_force;
             let torque = b.torque + b.constant_torque;
@@ -406,7 +406,17 @@ impl World {
         solver.build(ctx, &self.states, &candidates);
         self.candidates = candidates;
         self.profile.solver_setup = lap.lap();
-        solve_step(ctx, &self.sims, &self.states, &mut solver, &mut self.profile);
+        if ctx.parallel {
+            // Threads share the states as atomics for the substeps, then copy them back.
+            let shared: Vec<SharedState> = self.states.iter().map(|&s| SharedState::new(s)).collect();
+            solve_step(ctx, &self.sims, &shared, &mut solver, &mut self.profile);
+            for (s, x) in self.states.iter_mut().zip(&shared) {
+                *s = x.load();
+            }
+        } else {
+            let cells = core::cell::Cell::from_mut(&mut self.states[..]).as_slice_of_cells();
+            solve_step(ctx, &self.sims, cells, &mut solver, &mut self.profile);
+        }
         lap.lap();
         solver.store(ctx, &self.states, &self.candidates, &mut self.contacts);
         self.contact_solver = solver;
@@ -421,7 +431,7 @@ impl World {
             if b.solver_index == 0 {
                 return;
             }
-            let s = states[b.solver_index as usize].load();
+            let s = states[b.solver_index as usize];
             b.force = Vec2::ZERO;
             b.torque = 0.0;
             let finite =
