@@ -50,7 +50,7 @@ pub(crate) struct BodyState {
 /// two constraints touch the same moving body, and relaxed loads and stores are plain
 /// moves on 64-bit targets, so sharing needs no `unsafe` and costs little.
 #[derive(Debug, Default)]
-#[repr(align(32))]
+#[repr(align(64))]
 pub(crate) struct SharedState([AtomicU64; 4]);
 
 /// How the solver reads and writes body states, and how it splits work: one
