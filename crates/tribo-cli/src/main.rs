@@ -59,6 +59,9 @@ pub struct RunArgs {
     /// Substeps per step (overrides the scene).
     #[arg(long)]
     pub substeps: Option<u32>,
+    /// Worker threads for each step (1..=256; results are identical for every count).
+    #[arg(long, default_value_t = 1)]
+    pub threads: u32,
     /// Trajectory output: .csv or .jsonl.
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -166,7 +169,12 @@ fn run(args: &RunArgs) -> Result<(), String> {
         };
         format!("{flag}: {message}")
     })?;
-    let built = scene.build().map_err(|e| e.to_string())?;
+    let mut built = scene.build().map_err(|e| e.to_string())?;
+    let def = tribo::WorldDef {
+        workers: args.threads,
+        ..*built.world.def()
+    };
+    built.world.set_def(def).map_err(|e| format!("--threads: {e}"))?;
     let mut sim = output::Simulation::new(&scene, built);
     let mut writers = output::Writers::new(traj_kind, args.out.as_deref(), args.contacts.as_deref());
     let mut frames = output::FrameRecorder::new(picture_kind, scene.steps, scene.dt);
