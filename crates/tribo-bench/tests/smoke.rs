@@ -5,36 +5,59 @@
 
 use std::process::Command;
 
-#[test]
-fn every_scene_runs_for_every_engine() {
+/// Fields every JSON record has (the list).
+const FIELDS: [&str; 6] = [
+    "threads",
+    "runs",
+    "steps",
+    "ms_per_step_median",
+    "ms_per_step_min",
+    "check_passed",
+];
+
+/// Runs the benchmark program with `args` (plus JSON on stdout); returns stdout and the
+/// parsed records.
+fn run(args: &[&str]) -> (String, Vec<serde_json::Value>) {
     let out = Command::new(env!("CARGO_BIN_EXE_tribo-bench"))
-        .args(["all", "--runs", "1", "--steps", "3", "--json", "-"])
+        .args(args)
+        .args(["--json", "-"])
         .output()
         .expect("tribo-bench runs");
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stdout}\n{stderr}");
-    let records: Vec<serde_json::Value> = stdout
+    let records = stdout
         .lines()
         .filter(|l| l.starts_with('{'))
         .map(|l| serde_json::from_str(l).expect("json record"))
         .collect();
+    (stdout, records)
+}
+
+/// The record of `scene` and `engine`, with every field of `fields` present.
+fn record<'a>(
+    records: &'a [serde_json::Value],
+    stdout: &str,
+    scene: &str,
+    engine: &str,
+    fields: &[&str],
+) -> &'a serde_json::Value {
+    let r = records
+        .iter()
+        .find(|r| r["scene"] == scene && r["engine"] == engine)
+        .unwrap_or_else(|| panic!("no record for {scene}/{engine} in:\n{stdout}"));
+    for field in fields {
+        assert!(!r[*field].is_null(), "{scene}/{engine}: missing {field}");
+    }
+    r
+}
+
+#[test]
+fn every_scene_runs_for_every_engine() {
+    let (stdout, records) = run(&["all", "--runs", "1", "--steps", "3"]);
     for scene in ["large_pyramid", "many_pyramids", "smash", "tumbler"] {
         for engine in ["tribo", "box2d", "rapier"] {
-            let r = records
-                .iter()
-                .find(|r| r["scene"] == scene && r["engine"] == engine)
-                .unwrap_or_else(|| panic!("no record for {scene}/{engine} in:\n{stdout}"));
-            for field in [
-                "threads",
-                "runs",
-                "steps",
-                "ms_per_step_median",
-                "ms_per_step_min",
-                "check_passed",
-            ] {
-                assert!(!r[field].is_null(), "{scene}/{engine}: missing {field}");
-            }
+            let r = record(&records, &stdout, scene, engine, &FIELDS);
             assert!(r["ms_per_step_median"]
                 .as_f64()
                 .is_some_and(|v| v.is_finite() && v >= 0.0));
@@ -44,38 +67,11 @@ fn every_scene_runs_for_every_engine() {
 
 #[test]
 fn smallest_scaling_scene_runs_for_every_engine() {
-    let out = Command::new(env!("CARGO_BIN_EXE_tribo-bench"))
-        .args([
-            "scaling", "--sizes", "1000", "--runs", "1", "--steps", "3", "--json", "-",
-        ])
-        .output()
-        .expect("tribo-bench runs");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stdout}\n{stderr}");
+    let (stdout, records) = run(&["scaling", "--sizes", "1000", "--runs", "1", "--steps", "3"]);
     assert!(stdout.contains("== scaling:"), "no scaling table in:\n{stdout}");
-    let records: Vec<serde_json::Value> = stdout
-        .lines()
-        .filter(|l| l.starts_with('{'))
-        .map(|l| serde_json::from_str(l).expect("json record"))
-        .collect();
     for engine in ["tribo", "box2d", "rapier"] {
-        let r = records
-            .iter()
-            .find(|r| r["scene"] == "scaling_rain_1000" && r["engine"] == engine)
-            .unwrap_or_else(|| panic!("no record for scaling_rain_1000/{engine} in:\n{stdout}"));
-        for field in [
-            "threads",
-            "runs",
-            "steps",
-            "ms_per_step_median",
-            "ms_per_step_min",
-            "check_passed",
-            "bodies",
-            "us_per_step_per_body_median",
-        ] {
-            assert!(!r[field].is_null(), "{engine}: missing {field}");
-        }
+        let fields = [FIELDS.as_slice(), &["bodies", "us_per_step_per_body_median"]].concat();
+        let r = record(&records, &stdout, "scaling_rain_1000", engine, &fields);
         assert_eq!(r["dynamic_bodies"], 1000);
         assert_eq!(r["check_passed"], true, "{engine}: {}", r["check"]);
     }

@@ -405,22 +405,29 @@ pub fn conveyor() -> SceneFile {
     s
 }
 
+/// The four walls of a 20 m square drum (Box2D's tumbler): boxes half (0.5, 10) m at
+/// (±10, 0) and half (10, 0.5) m at (0, ±10) in the drum's frame.
+fn drum_walls(material: Option<MaterialRef>) -> Vec<ShapeSpec> {
+    [
+        ([10.0f32, 0.0f32], [0.5f32, 10.0f32]),
+        ([-10.0, 0.0], [0.5, 10.0]),
+        ([0.0, 10.0], [10.0, 0.5]),
+        ([0.0, -10.0], [10.0, 0.5]),
+    ]
+    .into_iter()
+    .map(|(center, half)| ShapeSpec {
+        center: Some(center),
+        ..box_shape(half[0], half[1], material.clone())
+    })
+    .collect()
+}
+
 /// A kinematic rotating box full of shapes.
 pub fn tumbler() -> SceneFile {
     let mut s = scene("a kinematic box turning at 25°/s full of boxes and disks", 600);
     let mut drum = body(Some("drum".into()), BodyKind::Kinematic, [0.0, 10.0], 0.0, Vec::new());
     drum.angular_velocity = 25f32.to_radians();
-    for (center, half) in [
-        ([10.0f32, 0.0f32], [0.5f32, 10.0f32]),
-        ([-10.0, 0.0], [0.5, 10.0]),
-        ([0.0, 10.0], [10.0, 0.5]),
-        ([0.0, -10.0], [10.0, 0.5]),
-    ] {
-        drum.shapes.push(ShapeSpec {
-            center: Some(center),
-            ..box_shape(half[0], half[1], None)
-        });
-    }
+    drum.shapes = drum_walls(None);
     s.bodies.push(drum);
     for i in 0..15 {
         for j in 0..15 {
@@ -488,17 +495,7 @@ pub fn tumbler_benchmark() -> SceneFile {
         Vec::new(),
     );
     drum.angular_velocity = TUMBLER_DRUM_SPEED;
-    for (center, half) in [
-        ([10.0f32, 0.0f32], [0.5f32, 10.0f32]),
-        ([-10.0, 0.0], [0.5, 10.0]),
-        ([0.0, 10.0], [10.0, 0.5]),
-        ([0.0, -10.0], [10.0, 0.5]),
-    ] {
-        drum.shapes.push(ShapeSpec {
-            center: Some(center),
-            ..box_shape(half[0], half[1], named("drum"))
-        });
-    }
+    drum.shapes = drum_walls(named("drum"));
     s.bodies.push(drum);
     for i in 0..45 {
         for j in 0..45 {
