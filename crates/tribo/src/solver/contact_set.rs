@@ -24,9 +24,13 @@ use super::contact_solver::{
 };
 use super::contact_wide::{self, WideCold, WideContact, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
-use super::{for_each_chunk_mut, for_each_mut2, ConstraintSet, StateCell, StateRead, StepContext};
+use super::{
+    for_each_chunk_mut, for_each_mut2, integrate_position_one, integrate_velocity_one, BodySim, ConstraintSet,
+    SharedState, SpinBarrier, StateCell, StateRead, StepContext,
+};
 use crate::collision::contact::Contact;
 use crate::math::Vec2;
+use crate::world::Stopwatch;
 
 /// Where a constraint lives during the substeps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -83,6 +87,21 @@ const CONTACT_STORE_CHUNK: usize = 512;
 
 /// No colour: the constraint goes to the overflow list.
 const OVERFLOW: u8 = u8::MAX;
+
+/// The colours' runs of `wide` as separate mutable slices (`ranges` ascending, disjoint).
+fn split_ranges<'a>(wide: &'a mut [WideContact], ranges: &[(u32, u32)]) -> Vec<&'a mut [WideContact]> {
+    let mut out = Vec::with_capacity(ranges.len());
+    let mut rest = wide;
+    let mut at = 0usize;
+    for &(start, end) in ranges {
+        let (_, tail) = rest.split_at_mut(start as usize - at);
+        let (colour, tail) = tail.split_at_mut((end - start) as usize);
+        out.push(colour);
+        rest = tail;
+        at = end as usize;
+    }
+    out
+}
 
 /// Whether a constraint side is a dynamic body (moves under impulses).
 #[inline]
@@ -421,6 +440,16 @@ impl ConstraintSet for ContactSolver {
         }
     }
 
+    fn substeps_team(
+        &mut self,
+        ctx: &StepContext,
+        sims: &[BodySim],
+        states: &[SharedState],
+        times: &mut [f32; 5],
+    ) -> bool {
+        self.team_loop(ctx, sims, states, times)
+    }
+
     fn restitution<S: StateCell>(&mut self, states: &[S]) {
         for cc in &mut self.overflow {
             restitution_one(cc, states);
@@ -441,6 +470,75 @@ impl ConstraintSet for ContactSolver {
 }
 
 impl ContactSolver {
+    /// The worker-team substep loop (see [`ConstraintSet::substeps_team`]): one job on
+    /// every thread of the pool for all substeps; each thread integrates its range of
+    /// bodies and solves its share of every colour, with a spin barrier after each colour
+    /// and stage. The shares are fixed (thread k takes the k-th chunk), and a colour's
+    /// constraints share no moving body, so the result does not depend on the thread
+    /// count. Only for steps without overflow constraints and mass-ratio groups (scalar
+    /// work the team would have to serialise); those run the per-colour path.
+    fn team_loop(&mut self, ctx: &StepContext, sims: &[BodySim], states: &[SharedState], times: &mut [f32; 5]) -> bool {
+        let threads = rayon::current_num_threads();
+        if threads < 2 || !self.overflow.is_empty() || !self.groups.is_empty() || self.wide.is_empty() {
+            return false;
+        }
+        let parts: Vec<Vec<std::sync::Mutex<&mut [WideContact]>>> = split_ranges(&mut self.wide, &self.ranges)
+            .into_iter()
+            .map(|c| {
+                let chunk = c.len().div_ceil(threads).max(1);
+                c.chunks_mut(chunk).map(std::sync::Mutex::new).collect()
+            })
+            .collect();
+        let bodies_per_thread = sims.len().div_ceil(threads).max(1);
+        let barrier = SpinBarrier::new(threads);
+        let times_out = std::sync::Mutex::new([0.0f32; 5]);
+        let each_colour = |k: usize, f: &dyn Fn(&mut WideContact)| {
+            for colour in &parts {
+                if let Some(part) = colour.get(k) {
+                    let mut guard = part.lock().unwrap_or_else(|e| e.into_inner());
+                    for w in guard.iter_mut() {
+                        f(w);
+                    }
+                }
+                barrier.wait();
+            }
+        };
+        rayon::broadcast(|bc| {
+            let k = bc.index();
+            let bodies = (k * bodies_per_thread).max(1)..((k + 1) * bodies_per_thread).min(sims.len());
+            let mut lap = Stopwatch::start();
+            let mut t = [0.0f32; 5];
+            for i in 0..ctx.substeps {
+                let elapsed = i as f32 * ctx.h;
+                for b in bodies.clone() {
+                    integrate_velocity_one(ctx.h, &sims[b], &states[b]);
+                }
+                barrier.wait();
+                t[0] += lap.lap();
+                each_colour(k, &|w| contact_wide::warm_start(w, states));
+                t[1] += lap.lap();
+                each_colour(k, &|w| {
+                    contact_wide::solve::<true, SharedState>(w, states, ctx, elapsed)
+                });
+                t[2] += lap.lap();
+                for b in bodies.clone() {
+                    integrate_position_one(ctx, &sims[b], &states[b]);
+                }
+                barrier.wait();
+                t[3] += lap.lap();
+                each_colour(k, &|w| {
+                    contact_wide::solve::<false, SharedState>(w, states, ctx, elapsed + ctx.h)
+                });
+                t[4] += lap.lap();
+            }
+            if k == 0 {
+                *times_out.lock().unwrap_or_else(|e| e.into_inner()) = t;
+            }
+        });
+        *times = times_out.into_inner().unwrap_or_else(|e| e.into_inner());
+        true
+    }
+
     /// Refreshes a copy's state from its slot (the coloured passes changed it).
     fn sync_from(&self, slot: Slot, cc: &mut ContactConstraint) {
         match slot {

@@ -99,6 +99,8 @@ pub(crate) trait StateCell: StateRead + Clone + Send {
     );
     /// Calls `f(i, states)` for `i` in `0..n` (split between threads for shared states).
     fn for_each_index(states: &[Self], n: usize, min_len: usize, f: impl Fn(usize, &[Self]) + Sync + Send);
+    /// The states as shared states, when they are (the worker-team path).
+    fn as_shared(states: &[Self]) -> Option<&[SharedState]>;
 }
 
 impl StateCell for core::cell::Cell<BodyState> {
@@ -129,6 +131,9 @@ impl StateCell for core::cell::Cell<BodyState> {
             f(i, states);
         }
     }
+    fn as_shared(_: &[Self]) -> Option<&[SharedState]> {
+        None
+    }
 }
 
 impl StateCell for SharedState {
@@ -157,7 +162,52 @@ impl StateCell for SharedState {
         use rayon::prelude::*;
         (0..n).into_par_iter().with_min_len(min_len).for_each(|i| f(i, states));
     }
+    fn as_shared(states: &[Self]) -> Option<&[SharedState]> {
+        Some(states)
+    }
 }
+
+/// A reusable barrier for the threads of one worker-team job (see
+/// `ContactSolver::substeps_team`): they spin, since the stages between two barriers last
+/// microseconds, and yield after a while so an oversubscribed machine still progresses.
+pub(crate) struct SpinBarrier {
+    threads: usize,
+    arrived: core::sync::atomic::AtomicUsize,
+    generation: core::sync::atomic::AtomicUsize,
+}
+
+impl SpinBarrier {
+    pub fn new(threads: usize) -> SpinBarrier {
+        SpinBarrier {
+            threads,
+            arrived: core::sync::atomic::AtomicUsize::new(0),
+            generation: core::sync::atomic::AtomicUsize::new(0),
+        }
+    }
+
+    /// Returns when all `threads` have called it (for this generation).
+    pub fn wait(&self) {
+        use core::sync::atomic::Ordering::{AcqRel, Acquire, Release};
+        let generation = self.generation.load(Acquire);
+        if self.arrived.fetch_add(1, AcqRel) + 1 == self.threads {
+            self.arrived.store(0, Release);
+            self.generation.fetch_add(1, Release);
+            return;
+        }
+        let mut spins = 0u32;
+        while self.generation.load(Acquire) == generation {
+            if spins < SPINS_BEFORE_YIELD {
+                core::hint::spin_loop();
+                spins += 1;
+            } else {
+                std::thread::yield_now();
+            }
+        }
+    }
+}
+
+/// Spins (≈ a few microseconds) before a waiting thread yields its core.
+const SPINS_BEFORE_YIELD: u32 = 4000;
 
 #[inline(always)]
 fn pack2(a: f32, b: f32) -> u64 {
@@ -345,6 +395,19 @@ pub(crate) trait ConstraintSet {
     fn end_substep(&mut self);
     /// Restitution pass after all substeps.
     fn restitution<C: StateCell>(&mut self, states: &[C]);
+    /// Runs the whole substep loop with a team of worker threads that stay awake between
+    /// stages (one job per step instead of one per colour and pass), when the set supports
+    /// it for this step; returns false (having done nothing) otherwise. `times` receives the
+    /// stage times of [`solve_step`]'s loop as measured by the first thread.
+    fn substeps_team(
+        &mut self,
+        _ctx: &StepContext,
+        _sims: &[BodySim],
+        _states: &[SharedState],
+        _times: &mut [f32; 5],
+    ) -> bool {
+        false
+    }
 }
 
 /// Runs the stages of one step over the awake bodies and a constraint set, timing each
@@ -367,7 +430,11 @@ pub(crate) fn solve_step<S: StateCell, C: ConstraintSet>(
     }
     profile.prepare = lap.lap();
     let mut t = [0.0f32; 5];
-    for i in 0..ctx.substeps {
+    let team = S::as_shared(states).is_some_and(|shared| constraints.substeps_team(ctx, sims, shared, &mut t));
+    if team {
+        lap.lap();
+    }
+    for i in 0..if team { 0 } else { ctx.substeps } {
         integrate_velocities(ctx, sims, states);
         t[0] += lap.lap();
         // Always called: it also records approach speeds (impulses are zero when warm
@@ -405,14 +472,19 @@ fn integrate_velocities<S: StateCell>(ctx: &StepContext, sims: &[BodySim], state
         if k == 0 {
             return;
         }
-        let (sim, state) = (&sims[k], &states[k]);
-        let s = state.get();
-        let lin = 1.0 / (1.0 + h * sim.linear_damping);
-        let ang = 1.0 / (1.0 + h * sim.angular_damping);
-        let v = (s.v + h * sim.linear_accel) * lin;
-        let w = (s.w + h * sim.angular_accel) * ang;
-        state.set_velocity(v, w, 0.0);
+        integrate_velocity_one(h, &sims[k], &states[k]);
     });
+}
+
+/// [`integrate_velocities`] for one body.
+#[inline]
+pub(crate) fn integrate_velocity_one<S: StateCell>(h: f32, sim: &BodySim, state: &S) {
+    let s = state.get();
+    let lin = 1.0 / (1.0 + h * sim.linear_damping);
+    let ang = 1.0 / (1.0 + h * sim.angular_damping);
+    let v = (s.v + h * sim.linear_accel) * lin;
+    let w = (s.w + h * sim.angular_accel) * ang;
+    state.set_velocity(v, w, 0.0);
 }
 
 /// Accumulates Δp += h·v and Δq ← Δq advanced by h·ω, with speed limits.
@@ -422,28 +494,33 @@ fn integrate_velocities<S: StateCell>(ctx: &StepContext, sims: &[BodySim], state
 /// (plain symplectic Euler overshoots by ½h²a per substep, which makes a dropped ball hit
 /// slower and bounce lower than e²h by about (1 + 1/e)·g·h/v).
 fn integrate_positions<S: StateCell>(ctx: &StepContext, sims: &[BodySim], states: &[S]) {
+    S::for_each_index(states, sims.len(), BODY_CHUNK, |k, states| {
+        if k == 0 {
+            return;
+        }
+        integrate_position_one(ctx, &sims[k], &states[k]);
+    });
+}
+
+/// [`integrate_positions`] for one body.
+#[inline]
+pub(crate) fn integrate_position_one<S: StateCell>(ctx: &StepContext, sim: &BodySim, state: &S) {
     let h = ctx.h;
     // Rotation per substep is limited to 0.25π per full step, as in Box2D, so the
     // first-order rotation update stays accurate.
     let max_w = 0.25 * core::f32::consts::PI / ctx.dt;
     let max_v2 = ctx.max_linear_speed * ctx.max_linear_speed;
-    S::for_each_index(states, sims.len(), BODY_CHUNK, |k, states| {
-        if k == 0 {
-            return;
-        }
-        let (sim, state) = (&sims[k], &states[k]);
-        let mut s = state.get();
-        if s.v.length_squared() > max_v2 {
-            s.v = s.v * (ctx.max_linear_speed / s.v.length());
-        }
-        s.w = s.w.clamp(-max_w, max_w);
-        let ballistic = s.touched == 0.0 && sim.linear_damping == 0.0;
-        s.dp += if ballistic {
-            h * (s.v - (0.5 * h) * sim.linear_accel)
-        } else {
-            h * s.v
-        };
-        s.dq = s.dq.integrate(h * s.w);
-        state.set(s);
-    });
+    let mut s = state.get();
+    if s.v.length_squared() > max_v2 {
+        s.v = s.v * (ctx.max_linear_speed / s.v.length());
+    }
+    s.w = s.w.clamp(-max_w, max_w);
+    let ballistic = s.touched == 0.0 && sim.linear_damping == 0.0;
+    s.dp += if ballistic {
+        h * (s.v - (0.5 * h) * sim.linear_accel)
+    } else {
+        h * s.v
+    };
+    s.dq = s.dq.integrate(h * s.w);
+    state.set(s);
 }
