@@ -43,7 +43,7 @@ impl BroadPhase {
 
     /// Moves a proxy to a new fat box and marks its shape as moved.
     pub fn move_proxy(&mut self, tree: u8, proxy: u32, aabb: Aabb, shape_index: u32) {
-        self.trees[tree as usize].move_proxy(proxy, aabb);
+        self.trees[tree as usize].move_proxy_near(proxy, aabb);
         self.moved.push(shape_index);
     }
 }

@@ -277,6 +277,39 @@ impl DynamicTree {
         true
     }
 
+    /// [`move_proxy`](Self::move_proxy) for a proxy that moved a little: while the new box
+    /// still overlaps its sibling's box (the leaf is still among its neighbours), the leaf
+    /// keeps its place and its ancestors are refitted exactly on the way up (stopping at
+    /// the first unchanged one): no removal, no SAH search, no rotations, and the boxes stay
+    /// tight. A proxy that left its neighbourhood is reinserted. Returns false when `proxy`
+    /// is not a live proxy or `aabb` is not valid.
+    pub fn move_proxy_near(&mut self, proxy: u32, aabb: Aabb) -> bool {
+        if !self.is_proxy(proxy) || !aabb.is_valid() {
+            return false;
+        }
+        let parent = self.nodes[proxy as usize].parent;
+        if parent == NULL_NODE {
+            self.nodes[proxy as usize].aabb = aabb;
+            return true;
+        }
+        let p = &self.nodes[parent as usize];
+        let sibling = if p.child1 == proxy { p.child2 } else { p.child1 };
+        if !aabb.overlaps(self.nodes[sibling as usize].aabb) {
+            return self.move_proxy(proxy, aabb);
+        }
+        self.nodes[proxy as usize].aabb = aabb;
+        let mut i = parent;
+        while i != NULL_NODE {
+            let before = self.nodes[i as usize].aabb;
+            self.refit(i);
+            if self.nodes[i as usize].aabb == before {
+                break; // every further ancestor is unchanged too
+            }
+            i = self.nodes[i as usize].parent;
+        }
+        true
+    }
+
     /// Cheap alternative to [`move_proxy`](Self::move_proxy) for a box that slightly
     /// outgrew its fat box: the leaf box becomes `leaf ∪ aabb` and the ancestors are grown
     /// in place (stopping at the first one that already holds it). No reinsertion, so tree
@@ -1136,7 +1169,8 @@ mod tests {
         v
     }
 
-    /// Random create / move / enlarge / destroy with validation and brute-force queries.
+    /// Random create / move / move near / enlarge / destroy with validation and brute-force
+    /// queries.
     #[test]
     fn random_operations_match_brute_force() {
         for (seed, budget) in [(12345, DEFAULT_SEARCH_BUDGET), (777, 0), (31, u32::MAX)] {
@@ -1161,10 +1195,23 @@ mod tests {
                     assert_ne!(id, NULL_NODE);
                     assert_eq!(t.user_data(id), Some(ud));
                     live.push((id, b, cat));
-                } else if op < 7 {
+                } else if op < 6 {
                     let k = r.below(live.len());
                     let b = random_box(&mut r, 100.0, 8.0);
                     assert!(t.move_proxy(live[k].0, b));
+                    live[k].1 = b;
+                } else if op < 7 {
+                    // A small move (kept in place, ancestors refitted) or a far one
+                    // (reinserted).
+                    let k = r.below(live.len());
+                    let old = live[k].1;
+                    let b = if r.below(2) == 0 {
+                        let d = Vec2::new(r.range(-0.5, 0.5), r.range(-0.5, 0.5));
+                        Aabb::new(old.min + d, old.max + d)
+                    } else {
+                        random_box(&mut r, 100.0, 8.0)
+                    };
+                    assert!(t.move_proxy_near(live[k].0, b));
                     live[k].1 = b;
                 } else if op < 8 {
                     let k = r.below(live.len());
