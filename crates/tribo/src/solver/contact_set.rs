@@ -14,8 +14,14 @@
 //! The physics of a lane and of a scalar constraint are the same ([`contact_wide`] docs);
 //! the scalar code still runs wherever it is simpler: overflow, the warm-start estimate of
 //! new contacts, the extra sweeps of light bodies under heavy ones, restitution, and
-//! storing impulses back into the contacts (each rebuilds a lane with
-//! [`contact_wide::unpack_full`] and writes its state back).
+//! storing impulses back into the contacts (each rebuilds what it needs of a lane with
+//! [`contact_wide::unpack_full`] or [`contact_wide::unpack_for_store`] and writes the
+//! lane's state back).
+//!
+//! With several threads, the substeps run as one job on every thread ([`team_loop`]):
+//! fixed shares of every colour, spin barriers between colours and stages.
+//!
+//! [`team_loop`]: ContactSolver::team_loop
 
 use super::contact_solver::{
     build_constraint, end_substep_one, estimate, has_fresh_point, is_new_resting, record_approach, restitution_one,
@@ -110,8 +116,8 @@ fn dynamic_side(inv_mass: f32, inv_i: f32) -> bool {
 }
 
 impl ContactSolver {
-    /// Builds the step's constraints from `candidates` (in solve order); `contacts` is the
-    /// world's contact list, `states` the awake bodies' solver states.
+    /// Builds the step's constraints from `candidates` (in solve order, each carrying its
+    /// contact's solver input); `states` are the awake bodies' solver states.
     pub fn build<S: StateRead + Sync>(&mut self, ctx: &StepContext, states: &[S], candidates: &[Candidate]) {
         self.overflow.clear();
         self.fresh.clear();
