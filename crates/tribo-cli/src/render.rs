@@ -1048,6 +1048,26 @@ fn poly_path(pts: &[[f32; 2]]) -> Option<tiny_skia::Path> {
 }
 
 /// Diagonal hatch lines clipped to `path`.
+/// Fills `path` (if `fill`), hatches it (if `hatch`), then strokes it (if `outline`).
+fn raster_shape(
+    pixmap: &mut Pixmap,
+    path: &tiny_skia::Path,
+    fill: Option<Rgba>,
+    hatch: bool,
+    outline: Option<(Rgba, Stroke)>,
+) {
+    let id = Transform::identity();
+    if let Some(f) = fill {
+        pixmap.fill_path(path, &paint(f, true), FillRule::Winding, id, None);
+    }
+    if hatch {
+        raster_hatch(pixmap, path);
+    }
+    if let Some((color, st)) = outline {
+        pixmap.stroke_path(path, &paint(color, true), &st, id, None);
+    }
+}
+
 fn raster_hatch(pixmap: &mut Pixmap, path: &tiny_skia::Path) {
     let b = path.bounds();
     let (w, h) = (pixmap.width() as f32, pixmap.height() as f32);
@@ -1168,17 +1188,13 @@ fn rasterize(prims: &[Prim], width: u32, height: u32) -> Result<Pixmap, RenderEr
                 sharp,
             } => {
                 if let Some(path) = poly_path(pts) {
-                    pixmap.fill_path(&path, &paint(*fill, true), FillRule::Winding, id, None);
-                    if *hatch {
-                        raster_hatch(&mut pixmap, &path);
-                    }
                     let join = if *sharp { LineJoin::Miter } else { LineJoin::Round };
                     let st = Stroke {
                         width: OUTLINE_WIDTH,
                         line_join: join,
                         ..Stroke::default()
                     };
-                    pixmap.stroke_path(&path, &paint(*stroke, true), &st, id, None);
+                    raster_shape(&mut pixmap, &path, Some(*fill), *hatch, Some((*stroke, st)));
                 }
             }
             Prim::Circle {
@@ -1189,19 +1205,14 @@ fn rasterize(prims: &[Prim], width: u32, height: u32) -> Result<Pixmap, RenderEr
                 stroke,
             } => {
                 if let Some(path) = PathBuilder::from_circle(c[0], c[1], *r) {
-                    if let Some(f) = fill {
-                        pixmap.fill_path(&path, &paint(*f, true), FillRule::Winding, id, None);
-                    }
-                    if *hatch {
-                        raster_hatch(&mut pixmap, &path);
-                    }
-                    if let Some((color, width)) = stroke {
+                    let outline = stroke.map(|(color, width)| {
                         let st = Stroke {
-                            width: *width,
+                            width,
                             ..Stroke::default()
                         };
-                        pixmap.stroke_path(&path, &paint(*color, true), &st, id, None);
-                    }
+                        (color, st)
+                    });
+                    raster_shape(&mut pixmap, &path, *fill, *hatch, outline);
                 }
             }
             Prim::Text {
