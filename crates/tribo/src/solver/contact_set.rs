@@ -1,8 +1,7 @@
 //! The contact constraints of one step, arranged for the solver stages: graph colouring,
 //! wide packing, overflow, mass-ratio groups, and the [`ConstraintSet`] stages over them.
 //!
-//! Build (once per step, from the touching contacts in solve order: pairs of moving
-//! bodies first, then pairs with a static side):
+//! Build (once per step, from the touching contacts in contact order):
 //! 1. colour every constraint (greedy first fit on per-body colour masks: moving pairs take
 //!    the lowest free colour, pairs with a static or kinematic side the highest, so each
 //!    pass solves them last, as Box2D v3's `constraint_graph.c` does); no free colour →
@@ -53,6 +52,24 @@ pub(crate) struct Candidate {
     pub contact: u32,
     pub bodies: ConstraintBodies,
     pub input: ContactInput,
+}
+
+impl Candidate {
+    /// A placeholder for a contact that is not solved this step.
+    pub const SKIP: Candidate = Candidate {
+        contact: u32::MAX,
+        bodies: ConstraintBodies {
+            index_a: 0,
+            index_b: 0,
+            inv_mass_a: 0.0,
+            inv_i_a: 0.0,
+            inv_mass_b: 0.0,
+            inv_i_b: 0.0,
+            center_a: Vec2::ZERO,
+            center_b: Vec2::ZERO,
+        },
+        input: ContactInput::EMPTY,
+    };
 }
 
 /// A light body's constraints, solved again ⌈M/m⌉ times per relax pass.
@@ -116,7 +133,7 @@ fn dynamic_side(inv_mass: f32, inv_i: f32) -> bool {
 }
 
 impl ContactSolver {
-    /// Builds the step's constraints from `candidates` (in solve order, each carrying its
+    /// Builds the step's constraints from `candidates` (in contact order, each carrying its
     /// contact's solver input); `states` are the awake bodies' solver states.
     pub fn build<S: StateRead + Sync>(&mut self, ctx: &StepContext, states: &[S], candidates: &[Candidate]) {
         self.overflow.clear();

@@ -169,6 +169,29 @@ pub(crate) struct InputPoint {
 }
 
 impl ContactInput {
+    /// No points, no material.
+    pub const EMPTY: ContactInput = ContactInput {
+        normal: Vec2::ZERO,
+        count: 0,
+        points: [InputPoint {
+            point: Vec2::ZERO,
+            separation: 0.0,
+            normal_impulse: 0.0,
+            tangent_impulse: 0.0,
+            preload: 0.0,
+            drift: 0.0,
+            stick: false,
+            fresh: false,
+        }; 2],
+        mu_s: 0.0,
+        mu_d: 0.0,
+        restitution: 0.0,
+        restitution_threshold: 0.0,
+        rolling_resistance: 0.0,
+        tangent_speed: 0.0,
+        rolling_impulse: 0.0,
+    };
+
     pub fn new(c: &Contact) -> ContactInput {
         let mut input = ContactInput {
             normal: c.manifold.normal,

@@ -367,14 +367,15 @@ pub(crate) fn for_each_chunk_mut<T: Send>(
     }
 }
 
-/// `items.iter().map(f).collect()`, split between the pool's threads when `parallel`
-/// (the output keeps the input's order).
-pub(crate) fn map_collect<T: Sync, U: Send>(parallel: bool, items: &[T], f: impl Fn(&T) -> U + Sync) -> Vec<U> {
+/// `out` = `f` of every item, in order (split between the worker threads if `parallel`);
+/// reuses `out`'s allocation.
+pub(crate) fn map_into<T: Sync, U: Send>(parallel: bool, items: &[T], out: &mut Vec<U>, f: impl Fn(&T) -> U + Sync) {
     if parallel {
         use rayon::prelude::*;
-        items.par_iter().with_min_len(256).map(|x| f(x)).collect()
+        items.par_iter().with_min_len(256).map(|x| f(x)).collect_into_vec(out);
     } else {
-        items.iter().map(f).collect()
+        out.clear();
+        out.extend(items.iter().map(f));
     }
 }
 

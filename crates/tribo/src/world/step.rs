@@ -17,7 +17,7 @@ use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::Candidate;
 use crate::solver::contact_solver::{ConstraintBodies, ContactInput};
-use crate::solver::{for_each_mut, map_collect, solve_step, BodySim, BodyState, SharedState, StepContext};
+use crate::solver::{for_each_mut, map_into, solve_step, BodySim, BodyState, SharedState, StepContext};
 use crate::world::Arena;
 use crate::world::BodyId;
 
@@ -355,13 +355,12 @@ impl World {
                 body: bi,
             });
         }
-        // Constraints: contacts between two moving bodies first, then contacts with static
-        // bodies, so the ground has the last word in each pass (as Box2D's colouring does).
+        // Constraints, in contact order (the colouring puts pairs with a static side in the
+        // top colours, so each pass still solves them last, as Box2D's colouring does).
         let mut candidates = core::mem::take(&mut self.candidates);
-        candidates.clear();
         let bodies = &self.bodies;
         let contacts = &self.contacts;
-        let found: Vec<Option<(bool, Candidate)>> = map_collect(ctx.parallel, &self.touching_contacts, |&ci| {
+        let candidate = |ci: u32| -> Option<Candidate> {
             let c = contacts.get(ci as usize)?.as_ref()?;
             if !c.touching {
                 return None;
@@ -371,7 +370,6 @@ impl World {
             if !awake_dynamic {
                 return None;
             }
-            let has_static = ba.solver_index == 0 || bb.solver_index == 0;
             let side = |b: &Body| {
                 if b.solver_index == 0 {
                     (0.0, 0.0)
@@ -380,27 +378,26 @@ impl World {
                 }
             };
             let ((inv_mass_a, inv_i_a), (inv_mass_b, inv_i_b)) = (side(ba), side(bb));
-            Some((
-                has_static,
-                Candidate {
-                    contact: ci,
-                    input: ContactInput::new(c),
-                    bodies: ConstraintBodies {
-                        index_a: ba.solver_index,
-                        index_b: bb.solver_index,
-                        inv_mass_a,
-                        inv_i_a,
-                        inv_mass_b,
-                        inv_i_b,
-                        center_a: ba.center,
-                        center_b: bb.center,
-                    },
+            Some(Candidate {
+                contact: ci,
+                input: ContactInput::new(c),
+                bodies: ConstraintBodies {
+                    index_a: ba.solver_index,
+                    index_b: bb.solver_index,
+                    inv_mass_a,
+                    inv_i_a,
+                    inv_mass_b,
+                    inv_i_b,
+                    center_a: ba.center,
+                    center_b: bb.center,
                 },
-            ))
+            })
+        };
+        // Written in place (no per-step allocation); the rare rejects are dropped after.
+        map_into(ctx.parallel, &self.touching_contacts, &mut candidates, |&ci| {
+            candidate(ci).unwrap_or(Candidate::SKIP)
         });
-        for pass_static in [false, true] {
-            candidates.extend(found.iter().flatten().filter(|f| f.0 == pass_static).map(|f| f.1));
-        }
+        candidates.retain(|c| c.contact != Candidate::SKIP.contact);
         let mut solver = core::mem::take(&mut self.contact_solver);
         solver.up = (-g).normalize_or_zero();
         solver.build(ctx, &self.states, &candidates);
