@@ -166,6 +166,16 @@ impl Contact {
         self.touching
     }
 
+    /// What [`Contact::update`] leaves when the shapes are too far apart for any point:
+    /// no points, no carried-over state.
+    pub fn clear_manifold(&mut self) {
+        self.manifold = Manifold::default();
+        self.points = [PointState::default(); MAX_MANIFOLD_POINTS];
+        self.rolling_impulse = 0.0;
+        self.touching = false;
+        self.basis = RecycleBasis::default();
+    }
+
     /// Reuses the manifold of a touching contact whose bodies moved less than
     /// [`RECYCLE_DISTANCE`] relative to each other since it was computed — each point's
     /// surface point on B seen from A and on A seen from B (a rolling disk moves its

@@ -160,6 +160,9 @@ pub(crate) struct Body {
     pub shapes: Vec<ShapeId>,
     /// Indices of the contacts this body takes part in.
     pub contacts: Vec<u32>,
+    /// The shape-pair key of each of `contacts` (same order): the broad phase checks a
+    /// body's short list before the world's pair table.
+    pub contact_keys: Vec<u64>,
     pub user_data: u64,
     /// Index of the body's state in the solver arrays during a step (0 = none/static).
     pub solver_index: u32,
@@ -199,6 +202,7 @@ impl Body {
             non_finite: false,
             shapes: Vec::new(),
             contacts: Vec::new(),
+            contact_keys: Vec::new(),
             user_data: def.user_data,
             solver_index: 0,
             sleep_island: u32::MAX,

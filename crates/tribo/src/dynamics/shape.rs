@@ -73,6 +73,10 @@ pub(crate) struct ShapeRecord {
     pub tree: u8,
     /// Fat box stored in the tree [m].
     pub fat_aabb: Aabb,
+    /// The shape's box at its body's last pose, grown by the speculative distance and
+    /// swept along the last step's motion [m] (inside `fat_aabb`): the narrow phase skips
+    /// the manifold of a pair whose boxes are apart.
+    pub aabb: Aabb,
     /// Set when the fat box was replaced this step (the broad phase looks for new pairs).
     pub moved: bool,
 }

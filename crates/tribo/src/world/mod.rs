@@ -553,15 +553,18 @@ impl World {
             proxy: u32::MAX,
             tree,
             fat_aabb: Aabb::new(Vec2::ZERO, Vec2::ZERO),
+            aabb: Aabb::new(Vec2::ZERO, Vec2::ZERO),
             moved: false,
         };
         let (index, generation) = self.shapes.insert(record);
         let id = ShapeId { index, generation };
-        let fat = shape_box(geometry, xf, v, 0.0).expand(AABB_MARGIN);
+        let aabb = shape_box(geometry, xf, v, 0.0);
+        let fat = aabb.expand(AABB_MARGIN);
         let proxy = self.broad_phase.create_proxy(tree, fat, def.filter.category, index);
         if let Some(s) = self.shapes.at_mut(index) {
             s.proxy = proxy;
             s.fat_aabb = fat;
+            s.aabb = aabb;
         }
         if let Some(b) = self.bodies.at_mut(body.index) {
             b.shapes.push(id);
@@ -776,6 +779,7 @@ impl World {
                 continue;
             };
             let aabb = shape_box(&s.geometry, xf, v, dt);
+            s.aabb = aabb;
             if !s.fat_aabb.contains(aabb) || dt == 0.0 {
                 let fat = aabb.expand(AABB_MARGIN);
                 s.fat_aabb = fat;
@@ -883,6 +887,7 @@ impl World {
             if let Some(b) = self.bodies.at_mut(bi) {
                 if let Some(pos) = b.contacts.iter().position(|&x| x == ci) {
                     b.contacts.swap_remove(pos);
+                    b.contact_keys.swap_remove(pos);
                 }
             }
         }

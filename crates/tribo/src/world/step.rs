@@ -100,21 +100,36 @@ impl World {
         let mut new_pairs: Vec<u64> = Vec::new();
         for &si in &moved {
             let Some(s) = self.shapes.at(si) else { continue };
+            let Some(body) = self.bodies.at(s.body.index) else {
+                continue;
+            };
             let trees: &[u8] = if s.tree == STATIC_TREE {
                 &[MOVING_TREE]
             } else {
                 &[MOVING_TREE, STATIC_TREE]
             };
+            // Most boxes a moved shape overlaps already have their contact: the cheap
+            // tests come first, the bodies (for their types) only for a new pair.
+            let exists = |key: u64| {
+                if body.contact_keys.len() <= SHORT_CONTACT_LIST {
+                    body.contact_keys.contains(&key)
+                } else {
+                    self.broad_phase.pairs.contains_key(&key)
+                }
+            };
             for &tree in trees {
                 self.broad_phase.trees[tree as usize].query(s.fat_aabb, s.filter.mask, |_, data| {
                     let other = data as u32;
-                    if other != si {
-                        if let Some(o) = self.shapes.at(other) {
-                            // When both moved, the lower index reports the pair.
-                            if !(o.moved && other < si) && self.pair_allowed(si, other) {
-                                new_pairs.push(pair_key(si, other));
-                            }
-                        }
+                    let Some(o) = self.shapes.at(other) else { return true };
+                    // When both moved, the lower index reports the pair.
+                    if other == si || (o.moved && other < si) || o.body == s.body {
+                        return true;
+                    }
+                    if !s.filter.should_collide(&o.filter) || exists(pair_key(si, other)) {
+                        return true;
+                    }
+                    if body.is_dynamic() || self.bodies.at(o.body.index).is_some_and(|b| b.is_dynamic()) {
+                        new_pairs.push(pair_key(si, other));
                     }
                     true
                 });
@@ -132,27 +147,6 @@ impl World {
         for key in new_pairs {
             self.create_contact((key >> 32) as u32, key as u32);
         }
-    }
-
-    /// Whether two shapes may form a contact: different bodies, at least one dynamic,
-    /// filters agree, no contact yet.
-    fn pair_allowed(&self, sa: u32, sb: u32) -> bool {
-        let (Some(a), Some(b)) = (self.shapes.at(sa), self.shapes.at(sb)) else {
-            return false;
-        };
-        if a.body == b.body {
-            return false;
-        }
-        let (Some(ba), Some(bb)) = (self.bodies.at(a.body.index), self.bodies.at(b.body.index)) else {
-            return false;
-        };
-        if !ba.is_dynamic() && !bb.is_dynamic() {
-            return false;
-        }
-        if !a.filter.should_collide(&b.filter) {
-            return false;
-        }
-        !self.broad_phase.pairs.contains_key(&pair_key(sa, sb))
     }
 
     fn create_contact(&mut self, sa: u32, sb: u32) {
@@ -194,6 +188,7 @@ impl World {
         for bi in [body_a, body_b] {
             if let Some(b) = self.bodies.at_mut(bi) {
                 b.contacts.push(ci);
+                b.contact_keys.push(pair_key(sa, sb));
             }
         }
     }
@@ -563,6 +558,10 @@ const BODY_CHUNK: usize = 256;
 /// Contacts per parallel chunk of the narrow phase and the impulse store.
 const CONTACT_CHUNK: usize = 256;
 
+/// Contact lists up to this long are searched for an existing pair instead of the pair
+/// table (a few keys in one cache line beat a hash probe into a large table).
+const SHORT_CONTACT_LIST: usize = 16;
+
 /// Updates one contact's manifold (recycled when its bodies barely moved); reads only the
 /// bodies and shapes, so contacts can be updated in parallel.
 fn narrow_phase(c: &mut Contact, bodies: &Arena<Body>, shapes: &Arena<ShapeRecord>, dt: f32) -> NarrowOutcome {
@@ -588,6 +587,15 @@ fn narrow_phase(c: &mut Contact, bodies: &Arena<Body>, shapes: &Arena<ShapeRecor
     let rel = (bb.v - ba.v).length() + ba.w.abs() * ba.max_extent + bb.w.abs() * bb.max_extent;
     let margin = SPECULATIVE_DISTANCE + dt * rel;
     let was = c.touching;
+    if !sa.aabb.expand(dt * rel).overlaps(sb.aabb) {
+        // The boxes are further apart than the margin (each grown by the speculative
+        // distance, and together by the relative motion): no point could be within it.
+        c.clear_manifold();
+        return NarrowOutcome::Updated {
+            touching: false,
+            changed: was,
+        };
+    }
     let now = c.recycle(ba.xf, bb.xf, 2.0 * ba.max_extent.min(bb.max_extent))
         || c.update(&sa.geometry, ba.xf, &sb.geometry, bb.xf, margin);
     NarrowOutcome::Updated {
