@@ -30,8 +30,8 @@ use super::contact_solver::{
 use super::contact_wide::{self, WideCold, WideContact, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
 use super::{
-    for_each_chunk_mut, for_each_mut2, integrate_position_one, integrate_velocity_one, BodySim, ConstraintSet,
-    SharedState, SpinBarrier, StateCell, StateRead, StepContext,
+    any_load, for_each_chunk_mut, for_each_mut2, integrate_position_one, integrate_velocity_one, BodySim,
+    ConstraintSet, SharedState, SpinBarrier, StateCell, StateRead, StepContext,
 };
 use crate::collision::contact::Contact;
 use crate::math::Vec2;
@@ -134,8 +134,15 @@ fn dynamic_side(inv_mass: f32, inv_i: f32) -> bool {
 
 impl ContactSolver {
     /// Builds the step's constraints from `candidates` (in contact order, each carrying its
-    /// contact's solver input); `states` are the awake bodies' solver states.
-    pub fn build<S: StateRead + Sync>(&mut self, ctx: &StepContext, states: &[S], candidates: &[Candidate]) {
+    /// contact's solver input); `states` and `sims` are the awake bodies' solver states and
+    /// step data.
+    pub fn build<S: StateRead + Sync>(
+        &mut self,
+        ctx: &StepContext,
+        states: &[S],
+        sims: &[BodySim],
+        candidates: &[Candidate],
+    ) {
         self.overflow.clear();
         self.fresh.clear();
         self.groups.clear();
@@ -261,7 +268,9 @@ impl ContactSolver {
                 }
             }
         }
-        self.build_groups(light, candidates);
+        if any_load(sims) {
+            self.build_groups(light, candidates);
+        }
     }
 
     /// Mass-ratio groups: each light body touching a moving body more than
@@ -269,6 +278,7 @@ impl ContactSolver {
     /// [`MAX_LOCAL_SWEEPS`]) extra times per relax pass. Sequential impulses move momentum
     /// through a light body between a heavy one and the ground only at a rate of about m/M
     /// per sweep, so a 100:1 stack needs ~100 sweeps where one is enough for equal masses.
+    /// Only when some body is loaded ([`super::any_load`]).
     fn build_groups(&mut self, mut light: Vec<(u32, u32)>, candidates: &[Candidate]) {
         if light.is_empty() {
             return;

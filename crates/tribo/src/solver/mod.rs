@@ -423,8 +423,9 @@ pub(crate) fn solve_step<S: StateCell, C: ConstraintSet>(
     let mut lap = Stopwatch::start();
     // A contact that begins at rest has no warm start: its first substeps would let the
     // body sag and slide before the load builds up (the settling creep of Box2D and
-    // Rapier). Estimate its impulses first on a scratch copy of the states.
-    if constraints.has_new_contacts() {
+    // Rapier). Estimate its impulses first on a scratch copy of the states; not when no
+    // body is loaded ([`any_load`]).
+    if constraints.has_new_contacts() && any_load(sims) {
         let trial = states.to_vec();
         integrate_velocities(ctx, sims, &trial);
         constraints.estimate_new_contacts(ctx, &trial);
@@ -460,6 +461,15 @@ pub(crate) fn solve_step<S: StateCell, C: ConstraintSet>(
     ] = t;
     constraints.restitution(states);
     profile.restitution = lap.lap();
+}
+
+/// Whether gravity or an applied force or torque acts on any awake body. Without, there
+/// is no static load to carry through the contacts (the impacts of a zero-gravity scene
+/// are the solver's ordinary work), so the helpers for carrying loads — the estimate of
+/// new resting contacts and the extra sweeps of light bodies under heavy ones — are off.
+pub(crate) fn any_load(sims: &[BodySim]) -> bool {
+    sims.iter()
+        .any(|s| s.linear_accel != Vec2::ZERO || s.angular_accel != 0.0)
 }
 
 /// Bodies per parallel chunk of the integration stages.

@@ -395,7 +395,7 @@ impl World {
         candidates.retain(|c| c.contact != Candidate::SKIP.contact);
         let mut solver = core::mem::take(&mut self.contact_solver);
         solver.up = (-g).normalize_or_zero();
-        solver.build(ctx, &self.states, &candidates);
+        solver.build(ctx, &self.states, &self.sims, &candidates);
         self.candidates = candidates;
         self.profile.solver_setup = lap.lap();
         if ctx.parallel {
