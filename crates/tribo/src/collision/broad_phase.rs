@@ -6,6 +6,7 @@
 //! fat boxes stop overlapping (checked in the narrow phase).
 
 use super::tree::DynamicTree;
+use crate::geometry::{Shape, SPECULATIVE_DISTANCE};
 use crate::math::Aabb;
 use std::collections::HashMap;
 
@@ -14,9 +15,21 @@ pub(crate) const STATIC_TREE: u8 = 0;
 /// Tree of kinematic and dynamic shapes.
 pub(crate) const MOVING_TREE: u8 = 1;
 
-/// Extra room [m] added around a shape's box when it is (re)inserted, so small motions
-/// do not touch the tree (Box2D v3 uses 0.05–0.1 m).
-pub(crate) const AABB_MARGIN: f32 = 0.1;
+/// Largest extra room [m] added around a moving shape's box when it is (re)inserted, so
+/// small motions do not touch the tree.
+pub(crate) const MAX_AABB_MARGIN: f32 = 0.05;
+
+/// The room [m] around a shape's box in the tree: for moving shapes 1/8 of the shape's
+/// reach from its centroid, at most [`MAX_AABB_MARGIN`]; for static shapes, which do not
+/// move, the speculative distance. A larger margin moves fewer proxies but makes more
+/// pairs of bodies that never touch (Box2D v3.2's `b2ComputeShapeMargin`, same values).
+pub(crate) fn aabb_margin(geometry: &Shape, is_static: bool) -> f32 {
+    if is_static {
+        SPECULATIVE_DISTANCE
+    } else {
+        (0.125 * geometry.max_extent(geometry.centroid())).min(MAX_AABB_MARGIN)
+    }
+}
 
 /// The broad phase.
 #[derive(Default)]

@@ -77,6 +77,9 @@ pub(crate) struct ShapeRecord {
     /// swept along the last step's motion [m] (inside `fat_aabb`): the narrow phase skips
     /// the manifold of a pair whose boxes are apart.
     pub aabb: Aabb,
+    /// Room [m] between `aabb` and `fat_aabb` when the fat box is renewed
+    /// ([`crate::collision::broad_phase::aabb_margin`]).
+    pub margin: f32,
     /// Set when the fat box was replaced this step (the broad phase looks for new pairs).
     pub moved: bool,
 }

@@ -18,7 +18,7 @@ pub use query::{QueryFilter, RayResult};
 
 pub(crate) use ids::Arena;
 
-use crate::collision::broad_phase::{BroadPhase, AABB_MARGIN, MOVING_TREE, STATIC_TREE};
+use crate::collision::broad_phase::{aabb_margin, BroadPhase, MOVING_TREE, STATIC_TREE};
 use crate::collision::contact::Contact;
 use crate::dynamics::body::Body;
 use crate::dynamics::shape::ShapeRecord;
@@ -554,12 +554,13 @@ impl World {
             tree,
             fat_aabb: Aabb::new(Vec2::ZERO, Vec2::ZERO),
             aabb: Aabb::new(Vec2::ZERO, Vec2::ZERO),
+            margin: aabb_margin(geometry, tree == STATIC_TREE),
             moved: false,
         };
         let (index, generation) = self.shapes.insert(record);
         let id = ShapeId { index, generation };
         let aabb = shape_box(geometry, xf, v, 0.0);
-        let fat = aabb.expand(AABB_MARGIN);
+        let fat = aabb.expand(aabb_margin(geometry, tree == STATIC_TREE));
         let proxy = self.broad_phase.create_proxy(tree, fat, def.filter.category, index);
         if let Some(s) = self.shapes.at_mut(index) {
             s.proxy = proxy;
@@ -781,7 +782,7 @@ impl World {
             let aabb = shape_box(&s.geometry, xf, v, dt);
             s.aabb = aabb;
             if !s.fat_aabb.contains(aabb) || dt == 0.0 {
-                let fat = aabb.expand(AABB_MARGIN);
+                let fat = aabb.expand(s.margin);
                 s.fat_aabb = fat;
                 let (tree, proxy) = (s.tree, s.proxy);
                 self.broad_phase.move_proxy(tree, proxy, fat, sid.index);
