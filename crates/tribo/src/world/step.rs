@@ -207,8 +207,11 @@ impl World {
         }
         let (bodies, shapes) = (&self.bodies, &self.shapes);
         for_each_mut(parallel, &mut self.contacts, CONTACT_CHUNK, |ci, slot| {
-            if let (Some(c), true) = (slot.as_mut(), mark[ci]) {
-                c.outcome = narrow_phase(c, bodies, shapes, dt);
+            // The mark first: a sleeping contact's record is not even read.
+            if mark[ci] {
+                if let Some(c) = slot.as_mut() {
+                    c.outcome = narrow_phase(c, bodies, shapes, dt);
+                }
             }
         });
         self.scratch_mark = mark;
@@ -270,16 +273,17 @@ impl World {
     /// cost nothing.
     fn collect_active_contacts(&self, out: &mut Vec<u32>, touching_only: bool) {
         out.clear();
-        let active = |bi: u32| {
-            self.bodies
-                .at(bi)
-                .is_some_and(|b| b.awake && b.body_type != BodyType::Static)
-        };
-        let awake = self
-            .bodies
-            .iter()
-            .filter(|(_, b)| b.awake && b.body_type != BodyType::Static)
-            .count();
+        // One flag per body slot, read in body order (the contacts then test two bytes
+        // instead of two body records).
+        let mut flags = vec![false; self.bodies.capacity()];
+        let mut awake = 0usize;
+        for (bi, b) in self.bodies.iter() {
+            if b.awake && b.body_type != BodyType::Static {
+                flags[bi as usize] = true;
+                awake += 1;
+            }
+        }
+        let active = |bi: u32| flags.get(bi as usize).copied().unwrap_or(false);
         if 2 * awake > self.bodies.len() {
             // Mostly awake: one pass in memory order beats chasing the bodies' lists.
             for (ci, c) in self.contacts.iter().enumerate() {
