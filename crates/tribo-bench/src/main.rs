@@ -361,7 +361,8 @@ fn run_scene(
 /// layer (1.0 m for large_pyramid's 100 layers, 0.1 m for many_pyramids' 10: each resting
 /// contact of a soft-contact solver may keep up to the 5 mm linear slop as penetration, so
 /// a correct engine's top box sinks up to ~5 mm per layer; a collapse drops metres) and
-/// drift less than 0.5 m sideways. Smash: the projectile must have hit and ploughed into the block
+/// drift less than 0.5 m sideways, and the pile must be at rest at the end (mean body
+/// speed below [`MAX_END_MEAN_SPEED`]). Smash: the projectile must have hit and ploughed into the block
 /// (final x in (30, 180) m, final speed in (1, 39) m/s; 180 m and 40 m/s would mean it
 /// passed through untouched) and total linear momentum must be conserved within 1 %
 /// (no gravity, no static bodies). Tumbler: every box centre, turned into the drum's frame
@@ -370,12 +371,17 @@ fn run_scene(
 /// ω t within 0.01 rad. Scaling rain: every body centre must be inside the container,
 /// |x| < its inner half width and y > 0 m (the floor's top). Every dynamic body's position
 /// must stay finite.
+/// A pyramid at the end of its run must be at rest: mean body speed below this [m/s]
+/// (Box2D v3 ends large_pyramid at 0.005 m/s, Rapier at 0.027; a swaying pile is faster).
+const MAX_END_MEAN_SPEED: f32 = 0.05;
+
 fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
     let dynamic: Vec<usize> = (0..scene.bodies.len())
         .filter(|&i| scene.bodies[i].kind == BodyKind::Dynamic)
         .collect();
     let mut finite = true;
     let mut max_disp = 0.0f32;
+    let (mut max_speed, mut sum_speed) = (0.0f32, 0.0f32);
     for &i in &dynamic {
         let p = sim.position(i);
         let p0 = scene.bodies[i].position;
@@ -384,7 +390,12 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
         } else {
             max_disp = max_disp.max(((p[0] - p0[0]).powi(2) + (p[1] - p0[1]).powi(2)).sqrt());
         }
+        let v = sim.velocity(i);
+        let speed = (v[0] * v[0] + v[1] * v[1]).sqrt();
+        max_speed = max_speed.max(speed);
+        sum_speed += speed;
     }
+    let mean_speed = sum_speed / dynamic.len().max(1) as f32;
     match bench.check {
         CheckKind::Pyramid { stack_layers } => {
             let max_drop = 0.01 * stack_layers as f32;
@@ -407,20 +418,24 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
                 }
                 drift = drift.max((p[0] - p0[0]).abs());
             }
-            let passed = finite && drop.abs() < max_drop && drift < 0.5;
+            let passed = finite && drop.abs() < max_drop && drift < 0.5 && mean_speed < MAX_END_MEAN_SPEED;
             Check {
                 passed,
                 text: format!(
-                    "top drop {:.4} m (< {:.2}), drift {:.4} m (< 0.5) ({} top box{}); max |Δp| any box {:.3} m",
+                    "top drop {:.4} m (< {:.2}), drift {:.4} m (< 0.5) ({} top box{}); max |Δp| any box {:.3} m; \
+                     speed at the end: max {:.3}, mean {:.4} m/s (< {MAX_END_MEAN_SPEED})",
                     drop,
                     max_drop,
                     drift,
                     tops.len(),
                     if tops.len() == 1 { "" } else { "es" },
-                    max_disp
+                    max_disp,
+                    max_speed,
+                    mean_speed
                 ),
                 json: json!({"top_drop_m": drop, "top_drop_limit_m": max_drop, "top_drift_m": drift, "tops": tops.len(),
-                             "max_displacement_m": max_disp, "finite": finite}),
+                             "max_displacement_m": max_disp, "finite": finite,
+                             "end_max_speed_m_s": max_speed, "end_mean_speed_m_s": mean_speed}),
             }
         }
         CheckKind::Smash => {
