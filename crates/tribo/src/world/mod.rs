@@ -544,6 +544,7 @@ impl World {
         };
         let xf = b.xf;
         let v = b.v;
+        let margin = aabb_margin(geometry, tree == STATIC_TREE);
         let record = ShapeRecord {
             body,
             geometry: *geometry,
@@ -554,13 +555,13 @@ impl World {
             tree,
             fat_aabb: Aabb::new(Vec2::ZERO, Vec2::ZERO),
             aabb: Aabb::new(Vec2::ZERO, Vec2::ZERO),
-            margin: aabb_margin(geometry, tree == STATIC_TREE),
+            margin,
             moved: false,
         };
         let (index, generation) = self.shapes.insert(record);
         let id = ShapeId { index, generation };
         let aabb = shape_box(geometry, xf, v, 0.0);
-        let fat = aabb.expand(aabb_margin(geometry, tree == STATIC_TREE));
+        let fat = aabb.expand(margin);
         let proxy = self.broad_phase.create_proxy(tree, fat, def.filter.category, index);
         if let Some(s) = self.shapes.at_mut(index) {
             s.proxy = proxy;
