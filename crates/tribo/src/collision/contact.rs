@@ -6,7 +6,7 @@
 
 use crate::dynamics::MixedMaterial;
 use crate::geometry::LINEAR_SLOP;
-use crate::geometry::{collide, Manifold, Shape, MAX_MANIFOLD_POINTS};
+use crate::geometry::{collide_after, Manifold, Shape, MAX_MANIFOLD_POINTS};
 use crate::math::{Rot, Transform, Vec2};
 use crate::world::ShapeId;
 
@@ -125,7 +125,7 @@ impl Contact {
     ) -> bool {
         let old_manifold = self.manifold;
         let old_points = self.points;
-        self.manifold = collide(geom_a, xf_a, geom_b, xf_b, speculative_distance);
+        self.manifold = collide_after(geom_a, xf_a, geom_b, xf_b, speculative_distance, &old_manifold);
         for i in 0..self.manifold.count {
             let id = self.manifold.points[i].id;
             let matched = (0..old_manifold.count).find(|&j| old_manifold.points[j].id == id);

@@ -16,7 +16,7 @@ mod raycast;
 mod shapes;
 
 pub use hull::convex_hull;
-pub use manifold::{collide, Manifold, ManifoldPoint, MAX_MANIFOLD_POINTS};
+pub use manifold::{collide, collide_after, Manifold, ManifoldPoint, MAX_MANIFOLD_POINTS};
 pub use mass::MassData;
 pub use raycast::{RayCastInput, RayHit};
 pub use shapes::{Capsule, Circle, Polygon, Segment, Shape, MAX_POLYGON_VERTICES};

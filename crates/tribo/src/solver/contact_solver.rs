@@ -35,10 +35,14 @@
 //! [`super::softness`]); with m the *light* body's effective mass this is how a heavy box
 //! sinks centimetres into a light one in soft-step engines, and how a tall stack
 //! compresses. Here the soft row relaxes towards a *preload* `λ_pre` instead of towards 0:
-//! `Δλ = −m·s_m·(v + β·C) − s_i·(λ − λ_pre)`. The preload tracks the point's load slowly
-//! (a fraction [`PRELOAD_RATE`] of the gap per step), so a steady load needs no deflection
-//! while impacts and load changes still meet the damped spring. Each point follows its
-//! own load, so a box on a slope does not tilt into the ground either. (With one sweep per
+//! `Δλ = −m·s_m·(v + β·C) − s_i·(λ − λ_pre)`. The preload is seeded once, when a point
+//! begins — by the warm-start estimate of a new resting contact, or by the load the point
+//! takes in its first step — and then kept while the point stays loaded (a step without
+//! load clears it), so a steady load needs no deflection while impacts and later load
+//! changes still meet the damped spring (a load added on top deflects it as in Box2D). It is deliberately not tracked afterwards: a preload that followed the load
+//! (even at 0.2 % of the gap per step) is an integrator around the chain of springs of a
+//! stack, and it kept the 100-row benchmark pyramid swaying at 0.05–0.25 m/s. Each point has
+//! its own preload, so a box on a slope does not tilt into the ground either. (With one sweep per
 //! point a per-point preload let tall towers rock; the 2×2 block normal solve below removed
 //! that coupling.)
 //!
@@ -628,12 +632,6 @@ fn solve_block(cc: &ContactConstraint, rows: &[NormalRow; 2]) -> Option<[f32; 2]
     None
 }
 
-/// Fraction of the gap between a point's preload and its current load closed per step.
-/// The preload is an integrator around a chain of springs: the taller the stack, the slower
-/// its slowest mode, and tracking faster than that mode makes it oscillate. 0.02 (a time
-/// constant of about 0.8 s) keeps a 40-row pyramid within 1 mm; 0.05 let it drift 9 cm.
-const PRELOAD_RATE: f32 = 0.02;
-
 /// Most rigid sweeps used to estimate the impulses of contacts that begin at rest.
 const MAX_ESTIMATE_SWEEPS: usize = 4096;
 
@@ -1046,13 +1044,15 @@ pub(crate) fn store_impulses<S: StateRead>(
         };
         ps.max_normal_impulse = cp.max_normal_impulse;
         ps.approach_velocity = cp.approach;
-        // Preload tracking (module docs); a new point starts at its first load.
-        let target = cp.normal_impulse;
-        let rate = if cp.fresh { 1.0 } else { PRELOAD_RATE };
-        ps.preload = if cp.max_normal_impulse > 0.0 {
-            cp.preload + rate * (target - cp.preload)
-        } else {
+        // Preload (module docs): seeded by a new point's load, then kept; a step without
+        // load clears it for good (re-seeding contacts whose load flickers, such as the
+        // side contacts of a pyramid's rows, kicked the pyramid into swaying).
+        ps.preload = if cp.max_normal_impulse <= 0.0 {
             0.0
+        } else if cp.fresh {
+            cp.normal_impulse
+        } else {
+            cp.preload
         };
         ps.fresh = false;
         let vt = point_velocity(cc, &a, &b, cp.r_a, cp.r_b).dot(t) - cc.tangent_speed;

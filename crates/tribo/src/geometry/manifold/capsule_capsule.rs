@@ -89,7 +89,7 @@ pub(super) fn capsules_local(a1: Vec2, a2: Vec2, ra: f32, b1: Vec2, b2: Vec2, rb
     if !(dist > CORE_TOUCH) {
         let pa = LocalPoly::from_segment(a1, a2, ra);
         let pb = LocalPoly::from_segment(b1, b2, rb);
-        return collide_polygons_local(&pa, &pb, spec);
+        return collide_polygons_local(&pa, &pb, spec, None);
     }
     let normal = delta * (1.0 / dist);
 

@@ -103,6 +103,21 @@ pub fn collide(
     xf_b: Transform,
     speculative_distance: f32,
 ) -> Manifold {
+    collide_after(shape_a, xf_a, shape_b, xf_b, speculative_distance, &Manifold::EMPTY)
+}
+
+/// [`collide`] for a pair whose manifold of the last step was `last`: two polygons keep
+/// the reference face they clipped against while the other face is not clearly better
+/// (see `polygon_polygon`), so the feature ids, and with them warm starting, friction
+/// state and preload, survive the sway of loaded stacks.
+pub fn collide_after(
+    shape_a: &Shape,
+    xf_a: Transform,
+    shape_b: &Shape,
+    xf_b: Transform,
+    speculative_distance: f32,
+    last: &Manifold,
+) -> Manifold {
     let spec = speculative_distance;
     match (shape_a, shape_b) {
         (Shape::Circle(a), Shape::Circle(b)) => circle_circle::collide_circles(a, xf_a, b, xf_b, spec),
@@ -121,7 +136,15 @@ pub fn collide(
 
         (Shape::Polygon(a), Shape::Circle(b)) => polygon_circle::collide_polygon_circle(a, xf_a, b, xf_b, spec),
         (Shape::Polygon(a), Shape::Capsule(b)) => polygon_capsule::collide_polygon_capsule(a, xf_a, b, xf_b, spec),
-        (Shape::Polygon(a), Shape::Polygon(b)) => polygon_polygon::collide_polygons(a, xf_a, b, xf_b, spec),
+        (Shape::Polygon(a), Shape::Polygon(b)) => {
+            let kind = last.active_points().first().map(|p| p.id >> 8);
+            let last_reference_b = match kind {
+                Some(KIND_CLIP_REF_A) => Some(false),
+                Some(KIND_CLIP_REF_B) => Some(true),
+                _ => None,
+            };
+            polygon_polygon::collide_polygons(a, xf_a, b, xf_b, spec, last_reference_b)
+        }
         (Shape::Polygon(a), Shape::Segment(b)) => polygon_segment::collide_polygon_segment(a, xf_a, b, xf_b, spec),
 
         (Shape::Segment(a), Shape::Circle(b)) => segment_circle::collide_segment_circle(a, xf_a, b, xf_b, spec),

@@ -7,7 +7,9 @@
 //!    core separation when the closest features are a vertex and an edge, and a lower bound on
 //!    the core distance otherwise, so `max > spec + r_a + r_b` means no contact.
 //! 2. The reference face is A's best edge unless B's is better by more than
-//!    `0.1 · LINEAR_SLOP` (so a box resting on a box does not swap faces from step to step).
+//!    `0.1 · LINEAR_SLOP`; for a pair whose last manifold clipped against one of two nearly
+//!    parallel faces, that face stays unless the other is better by more than
+//!    `LINEAR_SLOP` (so a box resting on a swaying box keeps its face, and its ids).
 //!    The incident edge is the edge of the other polygon whose normal is most anti-parallel to
 //!    the reference normal.
 //! 3. If the cores are apart (`max(sep) > 0.1 · LINEAR_SLOP`) and the closest points of the
@@ -25,6 +27,16 @@ use super::{
 };
 use crate::geometry::{Polygon, LINEAR_SLOP, MAX_POLYGON_VERTICES};
 use crate::math::{Transform, Vec2};
+
+/// How much better [m] the other face must be before a pair whose last manifold clipped
+/// against one face changes to the other. Two loaded boxes sway by a few mrad, which over
+/// half a metre changes which face separates more by over a millimetre; each swap changes
+/// every feature id, and the points lose their warm start, friction state and preload
+/// (in the 100-row benchmark pyramid, ~220 contacts per step with the 0.1·slop rule alone).
+const STICKY_REFERENCE: f32 = LINEAR_SLOP;
+
+/// Faces count as parallel for [`STICKY_REFERENCE`] within about 2.6° (cos = 0.999).
+const STICKY_PARALLEL_COS: f32 = 0.999;
 
 /// A polygon (or 2-vertex "polygon" for a capsule/segment) expressed in A's frame.
 #[derive(Clone, Copy, Debug)]
@@ -88,8 +100,14 @@ fn max_separation(p1: &LocalPoly, p2: &LocalPoly) -> (usize, f32) {
     (best_edge, best)
 }
 
-/// Polygon A against polygon B, both in A's frame. See the module documentation.
-pub(super) fn collide_polygons_local(a: &LocalPoly, b: &LocalPoly, spec: f32) -> LocalManifold {
+/// Polygon A against polygon B, both in A's frame. See the module documentation;
+/// `last_reference_b` is the face the pair's last manifold clipped against (step 2).
+pub(super) fn collide_polygons_local(
+    a: &LocalPoly,
+    b: &LocalPoly,
+    spec: f32,
+    last_reference_b: Option<bool>,
+) -> LocalManifold {
     let empty = LocalManifold::default();
     if a.count < 2 || b.count < 2 || a.count > MAX_POLYGON_VERTICES || b.count > MAX_POLYGON_VERTICES {
         return empty;
@@ -101,7 +119,14 @@ pub(super) fn collide_polygons_local(a: &LocalPoly, b: &LocalPoly, spec: f32) ->
         return empty;
     }
 
-    let flip = sep_b > sep_a + 0.1 * LINEAR_SLOP;
+    // Keeping the last reference only makes sense for two nearly parallel faces (either
+    // gives the same points); otherwise the better face gives the right normal.
+    let parallel = a.n[edge_a].dot(b.n[edge_b]) < -STICKY_PARALLEL_COS;
+    let flip = match last_reference_b.filter(|_| parallel) {
+        None => sep_b > sep_a + 0.1 * LINEAR_SLOP,
+        Some(false) => sep_b > sep_a + STICKY_REFERENCE,
+        Some(true) => sep_b + STICKY_REFERENCE >= sep_a,
+    };
     let (rf, inc, ref_edge) = if flip { (b, a, edge_b) } else { (a, b, edge_a) };
     let n = rf.n[ref_edge];
 
@@ -176,11 +201,19 @@ pub(super) fn collide_polygons_local(a: &LocalPoly, b: &LocalPoly, spec: f32) ->
     }
 }
 
-/// Contact between polygons `a` (placed by `xf_a`) and `b` (placed by `xf_b`).
-pub(super) fn collide_polygons(a: &Polygon, xf_a: Transform, b: &Polygon, xf_b: Transform, spec: f32) -> Manifold {
+/// Contact between polygons `a` (placed by `xf_a`) and `b` (placed by `xf_b`);
+/// `last_reference_b` as in [`collide_polygons_local`].
+pub(super) fn collide_polygons(
+    a: &Polygon,
+    xf_a: Transform,
+    b: &Polygon,
+    xf_b: Transform,
+    spec: f32,
+    last_reference_b: Option<bool>,
+) -> Manifold {
     let la = LocalPoly::from_polygon(a, Transform::IDENTITY);
     let lb = LocalPoly::from_polygon(b, xf_a.inv_mul(xf_b));
-    collide_polygons_local(&la, &lb, spec).to_world(xf_a, xf_b)
+    collide_polygons_local(&la, &lb, spec, last_reference_b).to_world(xf_a, xf_b)
 }
 
 #[cfg(test)]
@@ -401,6 +434,34 @@ mod tests {
         let m1 = collide(&b, xf(0.0, 0.0, 0.0), &b, xf(0.1, 0.999, 0.0), SPEC);
         let m2 = collide(&b, xf(0.0, 0.0, 0.0), &b, xf(0.1, 0.999, 1e-5), SPEC);
         assert_eq!(ids(&m1), ids(&m2));
+    }
+
+    #[test]
+    fn reference_face_sticks_while_the_other_is_not_clearly_better() {
+        use super::super::collide_after;
+        // Equal boxes offset sideways, B tilted so that its bottom face separates more
+        // than A's top face by more than 0.1·slop (the fresh choice takes B's face) but
+        // less than a slop (a pair that clipped against A's face keeps it).
+        let b = boxed(0.5, 0.5);
+        let (xa, xb) = (xf(0.0, 0.0, 0.0), xf(0.3, 0.999, -0.004));
+        let fresh = collide(&b, xa, &b, xb, SPEC);
+        let kind = |m: &Manifold| m.points[0].id >> 8;
+        assert_eq!(fresh.count, 2);
+        assert_eq!(kind(&fresh), super::super::KIND_CLIP_REF_B);
+        let on_a = collide(&b, xa, &b, xf(0.3, 0.999, 0.0), SPEC);
+        assert_eq!(kind(&on_a), super::super::KIND_CLIP_REF_A);
+        let kept = collide_after(&b, xa, &b, xb, SPEC, &on_a);
+        assert_eq!(kind(&kept), super::super::KIND_CLIP_REF_A);
+        assert_eq!(ids(&kept), ids(&on_a));
+        // Same contact either way: the normals agree within the tilt, the depths within
+        // the sticky margin.
+        assert!(kept.normal.dot(fresh.normal) > 0.999);
+        for (k, f) in kept.points[..2].iter().zip(&fresh.points[..2]) {
+            assert!((k.separation - f.separation).abs() < crate::geometry::LINEAR_SLOP);
+        }
+        // A clearly better face (tilt 0.02 rad, ~10 mm over the overlap) still wins.
+        let steep = collide_after(&b, xa, &b, xf(0.3, 0.999, -0.02), SPEC, &on_a);
+        assert_eq!(kind(&steep), super::super::KIND_CLIP_REF_B);
     }
 
     #[test]

@@ -17,7 +17,7 @@ pub(super) fn collide_polygon_segment(
     let rel = xf_a.inv_mul(xf_b);
     let pa = LocalPoly::from_polygon(a, Transform::IDENTITY);
     let pb = LocalPoly::from_segment(rel.apply(b.point1), rel.apply(b.point2), 0.0);
-    collide_polygons_local(&pa, &pb, spec).to_world(xf_a, xf_b)
+    collide_polygons_local(&pa, &pb, spec, None).to_world(xf_a, xf_b)
 }
 
 #[cfg(test)]
