@@ -89,6 +89,9 @@ pub(crate) struct ContactSolver {
     overflow: Vec<ContactConstraint>,
     /// Constraints with a point new this step.
     fresh: Vec<Slot>,
+    /// Gravity or a force acts on some body this step ([`super::any_load`]): the helpers
+    /// for carrying loads (estimate, mass-ratio groups) run only then.
+    loaded: bool,
     groups: Vec<Group>,
     /// `wide[ranges[k].0 .. ranges[k].1]`: the groups of the k-th non-empty colour.
     ranges: Vec<(u32, u32)>,
@@ -268,7 +271,8 @@ impl ContactSolver {
                 }
             }
         }
-        if any_load(sims) {
+        self.loaded = any_load(sims);
+        if self.loaded {
             self.build_groups(light, candidates);
         }
     }
@@ -380,7 +384,7 @@ impl ContactSolver {
 
 impl ConstraintSet for ContactSolver {
     fn has_new_contacts(&self) -> bool {
-        !self.fresh.is_empty()
+        self.loaded && !self.fresh.is_empty()
     }
 
     fn estimate_new_contacts<S: StateCell>(&mut self, ctx: &StepContext, trial: &[S]) -> bool {

@@ -382,7 +382,8 @@ pub(crate) fn map_into<T: Sync, U: Send>(parallel: bool, items: &[T], out: &mut 
 /// A family of constraints solved by the step (contacts now; joints later). The set is
 /// built before the step's stages run.
 pub(crate) trait ConstraintSet {
-    /// Whether any constraint has points new this step.
+    /// Whether any constraint has points new this step that carry a load worth estimating
+    /// (none when no body is loaded, see [`any_load`]).
     fn has_new_contacts(&self) -> bool;
     /// Estimates warm-start impulses for constraints that begin at rest (no history):
     /// rigid iterations against `trial`, the states after one substep of forces. Returns
@@ -423,9 +424,8 @@ pub(crate) fn solve_step<S: StateCell, C: ConstraintSet>(
     let mut lap = Stopwatch::start();
     // A contact that begins at rest has no warm start: its first substeps would let the
     // body sag and slide before the load builds up (the settling creep of Box2D and
-    // Rapier). Estimate its impulses first on a scratch copy of the states; not when no
-    // body is loaded ([`any_load`]).
-    if constraints.has_new_contacts() && any_load(sims) {
+    // Rapier). Estimate its impulses first on a scratch copy of the states.
+    if constraints.has_new_contacts() {
         let trial = states.to_vec();
         integrate_velocities(ctx, sims, &trial);
         constraints.estimate_new_contacts(ctx, &trial);

@@ -133,6 +133,8 @@ pub struct World {
     pub(crate) scratch_u32: Vec<u32>,
     pub(crate) scratch_f32: Vec<f32>,
     pub(crate) scratch_mark: Vec<bool>,
+    /// Scratch: one flag per body slot (active bodies, see `collect_active_contacts`).
+    pub(crate) scratch_flags: Vec<bool>,
     pub(crate) step_count: u64,
     pub(crate) profile: Profile,
     /// Worker threads when `def.workers > 1`.
@@ -176,6 +178,7 @@ impl World {
             scratch_u32: Vec::new(),
             scratch_f32: Vec::new(),
             scratch_mark: Vec::new(),
+            scratch_flags: Vec::new(),
             step_count: 0,
             profile: Profile::default(),
             pool: make_pool(def.workers)?,

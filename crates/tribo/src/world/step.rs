@@ -198,7 +198,9 @@ impl World {
     /// order, destroy contacts whose fat boxes separated, report begin/end, wake sleepers.
     fn collide(&mut self, dt: f32, parallel: bool) {
         let mut active = core::mem::take(&mut self.active_contacts);
-        self.collect_active_contacts(&mut active, false);
+        let mut flags = core::mem::take(&mut self.scratch_flags);
+        self.collect_active_contacts(&mut active, &mut flags, false);
+        self.scratch_flags = flags;
         let mut mark = core::mem::take(&mut self.scratch_mark);
         mark.clear();
         mark.resize(self.contacts.len(), false);
@@ -263,7 +265,9 @@ impl World {
             }
             // The woken islands' contacts join the solve with their last manifolds.
             let mut touching = core::mem::take(&mut self.touching_contacts);
-            self.collect_active_contacts(&mut touching, true);
+            let mut flags = core::mem::take(&mut self.scratch_flags);
+            self.collect_active_contacts(&mut touching, &mut flags, true);
+            self.scratch_flags = flags;
             self.touching_contacts = touching;
         }
     }
@@ -271,11 +275,13 @@ impl World {
     /// The contacts with an awake moving body (only touching ones if `touching_only`), in
     /// contact order: found through the awake bodies' contact lists, so sleeping islands
     /// cost nothing.
-    fn collect_active_contacts(&self, out: &mut Vec<u32>, touching_only: bool) {
+    /// `flags` is scratch (one flag per body slot).
+    fn collect_active_contacts(&self, out: &mut Vec<u32>, flags: &mut Vec<bool>, touching_only: bool) {
         out.clear();
         // One flag per body slot, read in body order (the contacts then test two bytes
         // instead of two body records).
-        let mut flags = vec![false; self.bodies.capacity()];
+        flags.clear();
+        flags.resize(self.bodies.capacity(), false);
         let mut awake = 0usize;
         for (bi, b) in self.bodies.iter() {
             if b.awake && b.body_type != BodyType::Static {
