@@ -50,26 +50,33 @@ pub(crate) struct PointState {
 }
 
 /// A contact between two shapes (internal record).
+///
+/// Laid out by use (`repr(C)`, whole cache lines): the passes in contact order that touch
+/// only a little of each record — the narrow phase's verdicts, the solver's candidates,
+/// the impulse store — find what they need (the liveness flag, `touching`, the outcome, the
+/// bodies, the point states) in the first two lines; the recycling basis and the shape ids,
+/// read only by the narrow phase and events, come last.
 #[derive(Clone, Debug)]
+#[repr(C, align(64))]
 pub(crate) struct Contact {
-    pub shape_a: ShapeId,
-    pub shape_b: ShapeId,
+    /// Whether the manifold has points.
+    pub touching: bool,
+    /// What the narrow phase of the current step found (read back in contact order).
+    pub outcome: NarrowOutcome,
     /// Body slot indices.
     pub body_a: u32,
     pub body_b: u32,
-    pub manifold: Manifold,
-    pub points: [PointState; MAX_MANIFOLD_POINTS],
-    pub material: MixedMaterial,
-    /// Rolling lever arm [m]: the larger rolling radius of the two shapes.
-    pub rolling_radius: f32,
     /// Rolling resistance impulse [N·m·s] of the last substep (warm start).
     pub rolling_impulse: f32,
-    /// Whether the manifold has points.
-    pub touching: bool,
+    /// Rolling lever arm [m]: the larger rolling radius of the two shapes.
+    pub rolling_radius: f32,
+    pub points: [PointState; MAX_MANIFOLD_POINTS],
+    pub manifold: Manifold,
+    pub material: MixedMaterial,
+    pub shape_a: ShapeId,
+    pub shape_b: ShapeId,
     /// Where the manifold was last computed, for recycling it.
     pub basis: RecycleBasis,
-    /// What the narrow phase of the current step found (read back in contact order).
-    pub outcome: NarrowOutcome,
 }
 
 /// The narrow phase's verdict on one contact in one step.

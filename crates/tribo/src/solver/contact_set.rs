@@ -30,8 +30,8 @@ use super::contact_solver::{
 use super::contact_wide::{self, WideCold, WideContact, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
 use super::{
-    any_load, for_each_chunk_mut, for_each_mut2, integrate_position_one, integrate_velocity_one, BodySim,
-    ConstraintSet, SharedState, SpinBarrier, StateCell, StateRead, StepContext,
+    any_load, for_each_mut2, integrate_position_one, integrate_velocity_one, BodySim, ConstraintSet, SharedState,
+    SpinBarrier, StateCell, StateRead, StepContext,
 };
 use crate::collision::contact::Contact;
 use crate::math::Vec2;
@@ -97,8 +97,6 @@ pub(crate) struct ContactSolver {
     ranges: Vec<(u32, u32)>,
     /// Candidate index of each lane of each group (`u32::MAX`: empty lane).
     lane_candidates: Vec<[u32; LANES]>,
-    /// Candidate index of each contact (`u32::MAX`: not solved this step).
-    slot_of_contact: Vec<u32>,
     // Scratch reused every step.
     colours: Vec<u8>,
     used: Vec<u32>,
@@ -245,20 +243,12 @@ impl ContactSolver {
             &mut self.cold,
             GROUP_CHUNK,
             |g, w, cold| {
-                w.any_rolling = false;
-                cold.any_restitution = false;
-                for (l, &i) in lane_candidates[g].iter().enumerate() {
-                    match candidates.get(i as usize) {
-                        Some(cand) => {
-                            let b = &cand.bodies;
-                            let cc = build_constraint(cand.contact, &cand.input, b, up, &soft, ctx, states);
-                            let da = dynamic_side(b.inv_mass_a, b.inv_i_a);
-                            let db = dynamic_side(b.inv_mass_b, b.inv_i_b);
-                            contact_wide::pack(w, cold, l, &cc, da, db);
-                        }
-                        None => contact_wide::clear_lane(w, cold, l),
-                    }
-                }
+                let lanes = lane_candidates[g].map(|i| {
+                    candidates
+                        .get(i as usize)
+                        .map(|cand| (cand.contact, &cand.input, &cand.bodies))
+                });
+                contact_wide::build_group(w, cold, lanes, up, &soft, ctx, states);
             },
         );
         for (g, cold) in self.cold.iter().enumerate() {
@@ -337,8 +327,10 @@ impl ContactSolver {
     }
 
     /// Writes every constraint's impulses and friction state back into its contact
-    /// (`contacts` is the world's contact list), split between the worker threads by
-    /// contact (each writes only its own contact).
+    /// (`contacts` is the world's contact list), in contact order: `candidates` are sorted
+    /// by contact, so only the solved contacts are visited. With threads, the candidates
+    /// are split into chunks whose contacts are disjoint ranges of the list (each chunk
+    /// writes only its own contacts).
     pub fn store<S: StateRead + Sync>(
         &mut self,
         ctx: &StepContext,
@@ -346,24 +338,15 @@ impl ContactSolver {
         candidates: &[Candidate],
         contacts: &mut [Option<Contact>],
     ) {
-        let mut slot_of = core::mem::take(&mut self.slot_of_contact);
-        slot_of.clear();
-        slot_of.resize(contacts.len(), u32::MAX);
-        for (i, cand) in candidates.iter().enumerate() {
-            if let Some(x) = slot_of.get_mut(cand.contact as usize) {
-                *x = i as u32;
-            }
-        }
         let this = &*self;
-        let slot_of_ref = &slot_of;
-        for_each_chunk_mut(ctx.parallel, contacts, CONTACT_STORE_CHUNK, |first, chunk| {
+        let store_run = |first: usize, cands: &[Candidate], base: usize, contacts: &mut [Option<Contact>]| {
             // A template whose fields that storing does not read stay as they are.
             let mut cc = ContactConstraint::default();
-            for (k, slot) in chunk.iter_mut().enumerate() {
-                let (Some(c), Some(&i)) = (slot.as_mut(), slot_of_ref.get(first + k)) else {
+            for (k, cand) in cands.iter().enumerate() {
+                let Some(Some(c)) = contacts.get_mut((cand.contact as usize).wrapping_sub(base)) else {
                     continue;
                 };
-                match this.slots.get(i as usize) {
+                match this.slots.get(first + k) {
                     Some(&Slot::Wide { group, lane }) => {
                         let g = group as usize;
                         contact_wide::unpack_for_store(&this.wide[g], &this.cold[g], lane as usize, &mut cc);
@@ -377,8 +360,26 @@ impl ContactSolver {
                     None => {}
                 }
             }
-        });
-        self.slot_of_contact = slot_of;
+        };
+        let ascending = candidates.windows(2).all(|p| p[0].contact < p[1].contact);
+        if !ctx.parallel || !ascending || candidates.len() <= CONTACT_STORE_CHUNK {
+            store_run(0, candidates, 0, contacts);
+            return;
+        }
+        // Disjoint contact ranges, one per chunk of candidates.
+        let mut runs = Vec::with_capacity(candidates.len().div_ceil(CONTACT_STORE_CHUNK));
+        let mut rest = contacts;
+        let mut base = 0usize;
+        for (k, chunk) in candidates.chunks(CONTACT_STORE_CHUNK).enumerate() {
+            let end = (chunk[chunk.len() - 1].contact as usize + 1).min(base + rest.len());
+            let (mine, tail) = rest.split_at_mut(end - base);
+            runs.push((k * CONTACT_STORE_CHUNK, chunk, base, mine));
+            rest = tail;
+            base = end;
+        }
+        use rayon::prelude::*;
+        runs.into_par_iter()
+            .for_each(|(first, chunk, base, mine)| store_run(first, chunk, base, mine));
     }
 }
 

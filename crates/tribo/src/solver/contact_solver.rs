@@ -306,11 +306,7 @@ pub(crate) fn build_constraint<S: StateRead>(
         cp.fresh = ps.fresh;
         cp.soft = point_soft;
         if cp.fresh {
-            // A new point starts sliding only if it is already in contact and slipping.
-            let dv = relative_velocity(&sa, &sb, r_a, r_b);
-            let slip = (dv.dot(t) - cc.tangent_speed).abs();
-            let in_contact = cp.base_separation <= crate::geometry::LINEAR_SLOP;
-            cp.stick = !(in_contact && slip > ctx.stick_speed);
+            cp.stick = fresh_point_sticks(&sa, &sb, r_a, r_b, t, cc.tangent_speed, cp.base_separation, ctx);
         }
     }
     if cc.count == 2 {
@@ -332,6 +328,27 @@ pub(crate) fn build_constraint<S: StateRead>(
         }
     }
     cc
+}
+
+/// The friction state a new point starts in: sliding only if it is already in contact
+/// (separation ≤ linear slop [m]) and slipping faster than `ctx.stick_speed` [m/s] at the
+/// bodies' step-start velocities; otherwise sticking.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn fresh_point_sticks(
+    sa: &BodyState,
+    sb: &BodyState,
+    r_a: Vec2,
+    r_b: Vec2,
+    t: Vec2,
+    tangent_speed: f32,
+    separation: f32,
+    ctx: &StepContext,
+) -> bool {
+    let dv = relative_velocity(sa, sb, r_a, r_b);
+    let slip = (dv.dot(t) - tangent_speed).abs();
+    let in_contact = separation <= crate::geometry::LINEAR_SLOP;
+    !(in_contact && slip > ctx.stick_speed)
 }
 
 /// The two softness settings of a step's contacts.
@@ -700,6 +717,19 @@ fn lever_arms(cc: &ContactConstraint, a: &BodyState, b: &BodyState, r_a: Vec2, r
 
 /// Kinetic energy [J] of a constraint's two bodies (a static side counts zero).
 fn pair_kinetic_energy(cc: &ContactConstraint, a: &BodyState, b: &BodyState) -> f32 {
+    kinetic_energy_of(cc.inv_mass_a, cc.inv_i_a, cc.inv_mass_b, cc.inv_i_b, a, b)
+}
+
+/// [`pair_kinetic_energy`] from the two sides' inverse masses [1/kg] and inertias
+/// [1/(kg·m²)].
+pub(crate) fn kinetic_energy_of(
+    inv_mass_a: f32,
+    inv_i_a: f32,
+    inv_mass_b: f32,
+    inv_i_b: f32,
+    a: &BodyState,
+    b: &BodyState,
+) -> f32 {
     let part = |inv_m: f32, inv_i: f32, s: &BodyState| {
         let lin = if inv_m > 0.0 {
             0.5 * s.v.length_squared() / inv_m
@@ -709,7 +739,7 @@ fn pair_kinetic_energy(cc: &ContactConstraint, a: &BodyState, b: &BodyState) -> 
         let ang = if inv_i > 0.0 { 0.5 * s.w * s.w / inv_i } else { 0.0 };
         lin + ang
     };
-    part(cc.inv_mass_a, cc.inv_i_a, a) + part(cc.inv_mass_b, cc.inv_i_b, b)
+    part(inv_mass_a, inv_i_a, a) + part(inv_mass_b, inv_i_b, b)
 }
 
 /// Relative velocity at a contact point, measured at the common point of [`lever_arms`].

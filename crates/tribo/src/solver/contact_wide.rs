@@ -23,7 +23,10 @@
 //! A lane computes the same expressions as the scalar code in the same order of
 //! operations, so a contact solved wide or scalar gets the same numbers.
 
-use super::contact_solver::{ConstraintPoint, ContactConstraint};
+use super::contact_solver::{
+    fresh_point_sticks, kinetic_energy_of, ConstraintBodies, ConstraintPoint, ContactConstraint, ContactInput,
+    StepSoftness,
+};
 use super::wide::{F4, LANES, M4, V4};
 use super::Softness;
 use super::{StateCell, StateRead, StepContext};
@@ -351,14 +354,183 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     scatter(states, &c.index_b, &c.write_b, &b);
 }
 
-/// Empties lane `l` (static body on both sides, no mass, no impulse): it then changes
-/// nothing when solved.
-pub(crate) fn clear_lane(w: &mut WideContact, cold: &mut WideCold, l: usize) {
-    let empty = WideContact::default();
-    let empty_cold = WideCold::default();
-    let mut cc = unpack_full(&empty, &empty_cold, 0);
-    cc.count = 0;
-    pack(w, cold, l, &cc, false, false);
+/// One lane's constraint to build: its contact index, solver input and bodies.
+pub(crate) type LaneInput<'a> = Option<(u32, &'a ContactInput, &'a ConstraintBodies)>;
+
+/// Builds four constraints straight into a group: lane by lane the same numbers as
+/// `contact_solver::build_constraint` followed by [`pack`] (the same expressions in the
+/// same order), but the masses, the 2×2 block and the friction row are computed four lanes
+/// at a time and the group is written whole, not field by field per lane. An empty lane
+/// has the static body on both sides, no mass and no impulse: solving it changes nothing.
+pub(crate) fn build_group<S: StateRead>(
+    w: &mut WideContact,
+    cold: &mut WideCold,
+    lanes: [LaneInput<'_>; LANES],
+    up: Vec2,
+    soft: &StepSoftness,
+    ctx: &StepContext,
+    states: &[S],
+) {
+    let warm = ctx.warm_starting;
+    let zero = F4::ZERO;
+    let one = F4::splat(1.0);
+    let half = F4::splat(0.5);
+    let mut out = WideContact::default();
+    let mut c = WideCold::default();
+    // Per-lane inputs (zero in empty lanes and absent points).
+    let (mut center_a, mut center_b, mut point) = (V4::default(), V4::default(), [V4::default(); 2]);
+    let mut has = [M4::default(); 2];
+    let mut tangent_sum = F4::ZERO;
+    for (l, lane) in lanes.iter().enumerate() {
+        let Some((contact, input, b)) = *lane else {
+            // clear_lane: nothing but a sticking, empty friction row.
+            out.stick.0[l] = u32::MAX;
+            continue;
+        };
+        let count = input.count.min(2);
+        c.contact[l] = contact;
+        c.count[l] = count as u8;
+        c.restitution[l] = input.restitution;
+        c.restitution_threshold[l] = input.restitution_threshold;
+        c.any_restitution |= input.restitution > 0.0;
+        c.height[l] = if count > 0 { input.points[0].point.dot(up) } else { 0.0 };
+        out.index_a[l] = b.index_a;
+        out.index_b[l] = b.index_b;
+        out.write_a[l] = (b.inv_mass_a > 0.0 || b.inv_i_a > 0.0) && b.index_a != 0;
+        out.write_b[l] = (b.inv_mass_b > 0.0 || b.inv_i_b > 0.0) && b.index_b != 0;
+        out.normal.x.0[l] = input.normal.x;
+        out.normal.y.0[l] = input.normal.y;
+        out.inv_mass_a.0[l] = b.inv_mass_a;
+        out.inv_i_a.0[l] = b.inv_i_a;
+        out.inv_mass_b.0[l] = b.inv_mass_b;
+        out.inv_i_b.0[l] = b.inv_i_b;
+        center_a.x.0[l] = b.center_a.x;
+        center_a.y.0[l] = b.center_a.y;
+        center_b.x.0[l] = b.center_b.x;
+        center_b.y.0[l] = b.center_b.y;
+        out.mu_s.0[l] = input.mu_s;
+        out.mu_d.0[l] = input.mu_d;
+        out.tangent_speed.0[l] = input.tangent_speed;
+        out.rolling_resistance.0[l] = input.rolling_resistance;
+        let rolling_impulse = if warm { input.rolling_impulse } else { 0.0 };
+        out.rolling_impulse.0[l] = rolling_impulse;
+        out.any_rolling |= input.rolling_resistance > 0.0 || rolling_impulse != 0.0;
+        // Contacts with static bodies are twice as stiff (Box2D v3's static softness).
+        let ps = if b.index_a == 0 || b.index_b == 0 {
+            soft.static_contact
+        } else {
+            soft.contact
+        };
+        out.bias_rate.0[l] = ps.bias_rate;
+        out.mass_scale.0[l] = ps.mass_scale;
+        out.impulse_scale.0[l] = ps.impulse_scale;
+        let states_ab = input.points[..count]
+            .iter()
+            .any(|p| p.fresh)
+            .then(|| (states[b.index_a as usize].get(), states[b.index_b as usize].get()));
+        if input.restitution > 0.0 {
+            let (sa, sb) = (states[b.index_a as usize].get(), states[b.index_b as usize].get());
+            c.kinetic_energy[l] = kinetic_energy_of(b.inv_mass_a, b.inv_i_a, b.inv_mass_b, b.inv_i_b, &sa, &sb);
+        }
+        let t = input.normal.right_perp();
+        let mut ts = [0.0f32; 2];
+        let mut row_stick = true;
+        for (i, ip) in input.points[..count].iter().enumerate() {
+            has[i].0[l] = u32::MAX;
+            point[i].x.0[l] = ip.point.x;
+            point[i].y.0[l] = ip.point.y;
+            let wp = &mut out.points[i];
+            wp.base_separation.0[l] = ip.separation;
+            if warm {
+                wp.normal_impulse.0[l] = ip.normal_impulse;
+                wp.preload.0[l] = ip.preload;
+                ts[i] = ip.tangent_impulse;
+            }
+            c.base_drift[i][l] = if ip.stick && !ip.fresh { ip.drift } else { 0.0 };
+            let stick = match states_ab {
+                Some((sa, sb)) if ip.fresh => {
+                    let (r_a, r_b) = (ip.point - b.center_a, ip.point - b.center_b);
+                    fresh_point_sticks(&sa, &sb, r_a, r_b, t, input.tangent_speed, ip.separation, ctx)
+                }
+                _ => ip.stick,
+            };
+            c.stick[i][l] = stick;
+            c.fresh[i][l] = ip.fresh;
+            row_stick &= stick;
+        }
+        // Summed as `pack_state` sums (the same sign of a zero sum).
+        tangent_sum.0[l] = ts[..count].iter().sum();
+        out.stick.0[l] = if row_stick { u32::MAX } else { 0 };
+        out.tangent_share[0].0[l] = match count {
+            2 => 0.5,
+            1 => 1.0,
+            _ => 0.0,
+        };
+        out.tangent_share[1].0[l] = if count == 2 { 0.5 } else { 0.0 };
+    }
+    out.tangent_impulse = tangent_sum;
+    // Four lanes at once (contact_solver::build_constraint and pack).
+    let n = out.normal;
+    let t = V4 { x: n.y, y: -n.x };
+    let (ma, ia, mb, ib) = (out.inv_mass_a, out.inv_i_a, out.inv_mass_b, out.inv_i_b);
+    // k = m_a⁻¹ + m_b⁻¹ + I_a⁻¹ (r_a × d)² + I_b⁻¹ (r_b × d)² (effective_mass_inv).
+    let k_of = |r_a: V4, r_b: V4, d: V4| {
+        let (ra, rb) = (r_a.cross(d), r_b.cross(d));
+        ma + mb + ia * ra * ra + ib * rb * rb
+    };
+    let inv_or_zero = |k: F4| k.gt(zero).select(one / k, zero);
+    let sum = ma + mb;
+    out.split = sum.gt(zero).select(mb / sum, half);
+    let k_roll = ia + ib;
+    out.rolling_mass = inv_or_zero(k_roll);
+    let mut arms = [(V4::default(), V4::default()); 2];
+    let mut kn = [zero; 2];
+    for i in 0..2 {
+        let keep = |v: V4| V4 {
+            x: has[i].select(v.x, zero),
+            y: has[i].select(v.y, zero),
+        };
+        let (r_a, r_b) = (keep(point[i] - center_a), keep(point[i] - center_b));
+        arms[i] = (r_a, r_b);
+        kn[i] = k_of(r_a, r_b, n);
+        let wp = &mut out.points[i];
+        wp.r_a = r_a;
+        wp.r_b = r_b;
+        wp.normal_mass = has[i].select(inv_or_zero(kn[i]), zero);
+    }
+    let ((ra0, rb0), (ra1, rb1)) = (arms[0], arms[1]);
+    let two = has[1];
+    // Friction row: the patch middle of two points, or the single point.
+    let mid = |p: V4, q: V4| (p + q).scale(half);
+    let pick = |m: M4, p: V4, q: V4| V4 {
+        x: m.select(p.x, q.x),
+        y: m.select(p.y, q.y),
+    };
+    out.friction_r_a = pick(two, mid(ra0, ra1), ra0);
+    out.friction_r_b = pick(two, mid(rb0, rb1), rb0);
+    out.tangent_mass = has[0].select(inv_or_zero(k_of(out.friction_r_a, out.friction_r_b, t)), zero);
+    let d0 = F4(c.base_drift[0]);
+    let d1 = F4(c.base_drift[1]);
+    out.base_drift = two.select(half * (d0 + d1), d0);
+    // The 2×2 normal block (Box2D v2.4's guard: none when K is near singular).
+    let (k11, k22) = (kn[0], kn[1]);
+    let (c0, c1) = (ra0.cross(n), ra1.cross(n));
+    let (e0, e1) = (rb0.cross(n), rb1.cross(n));
+    let k12 = ma + mb + ia * c0 * c1 + ib * e0 * e1;
+    let det = k11 * k22 - k12 * k12;
+    let block = two & (k11 * k11).lt(F4::splat(1000.0) * det) & det.gt(zero);
+    let inv = one / det;
+    out.block = block;
+    out.k11 = block.select(k11, zero);
+    out.k12 = block.select(k12, zero);
+    out.k22 = block.select(k22, zero);
+    out.i11 = block.select(k22 * inv, zero);
+    out.i12 = block.select(-k12 * inv, zero);
+    out.i22 = block.select(k11 * inv, zero);
+    out.inv_k11 = block.select(one / k11, zero);
+    out.inv_k22 = block.select(one / k22, zero);
+    *w = out;
+    *cold = c;
 }
 
 /// Copies a scalar constraint into lane `l` (everything: geometry, masses, state).
@@ -604,4 +776,128 @@ pub(crate) fn unpack_for_store(w: &WideContact, cold: &WideCold, l: usize, cc: &
         cp.fresh = cold.fresh[i][l];
     }
     unpack_state(w, l, cc);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Rot;
+    use crate::solver::contact_solver::{build_constraint, InputPoint};
+    use crate::solver::BodyState;
+
+    fn input(count: usize, fresh: bool, restitution: f32, rolling: f32) -> ContactInput {
+        let point = |x: f32, sep: f32| InputPoint {
+            point: Vec2::new(x, 0.3),
+            separation: sep,
+            normal_impulse: 0.7 + x,
+            tangent_impulse: -0.2 * x,
+            preload: 0.5,
+            drift: 1e-3 * x,
+            stick: x > 0.0,
+            fresh,
+        };
+        ContactInput {
+            normal: Vec2::new(0.6, 0.8),
+            count,
+            points: [point(0.25, -0.004), point(-0.35, 0.002)],
+            mu_s: 0.9,
+            mu_d: 0.6,
+            restitution,
+            restitution_threshold: 1.0,
+            rolling_resistance: rolling,
+            tangent_speed: 0.1,
+            rolling_impulse: 0.01,
+        }
+    }
+
+    fn bodies(index_a: u32, index_b: u32) -> ConstraintBodies {
+        let side = |i: u32, m: f32| if i == 0 { (0.0, 0.0) } else { (1.0 / m, 6.0 / m) };
+        let ((inv_mass_a, inv_i_a), (inv_mass_b, inv_i_b)) = (side(index_a, 2.0), side(index_b, 0.5));
+        ConstraintBodies {
+            index_a,
+            index_b,
+            inv_mass_a,
+            inv_i_a,
+            inv_mass_b,
+            inv_i_b,
+            center_a: Vec2::new(0.1, -0.2),
+            center_b: Vec2::new(-0.3, 0.9),
+        }
+    }
+
+    /// The wide build must give every lane exactly what the scalar build followed by
+    /// `pack` gives (the solver's lanes and its scalar paths — overflow, estimate,
+    /// mass-ratio sweeps — must agree bit for bit): re-packing each real lane from the
+    /// scalar constraint over the wide result changes nothing. Covers two-point and
+    /// one-point manifolds, a static side, new points (whose stick/slip state is decided
+    /// from the step-start velocities: one in contact and slipping, one not), restitution,
+    /// rolling resistance and an empty lane.
+    #[test]
+    fn wide_build_equals_scalar_build_and_pack() {
+        let ctx = StepContext {
+            dt: 1.0 / 60.0,
+            h: 1.0 / 240.0,
+            inv_h: 240.0,
+            substeps: 4,
+            contact_hertz: 30.0,
+            contact_damping_ratio: 10.0,
+            push_speed: 3.0,
+            stick_speed: 0.01,
+            max_linear_speed: 400.0,
+            warm_starting: true,
+            parallel: false,
+        };
+        let soft = StepSoftness::new(&ctx);
+        let state = |vx: f32, w: f32| BodyState {
+            v: Vec2::new(vx, -0.5),
+            w,
+            touched: 0.0,
+            dp: Vec2::ZERO,
+            dq: Rot::IDENTITY,
+        };
+        let states = vec![
+            BodyState::default(),
+            state(0.4, 1.5),
+            state(-0.3, -0.7),
+            state(2.0, 0.0),
+        ];
+        let up = Vec2::new(0.0, 1.0);
+        let cases = [
+            (7u32, input(2, false, 0.0, 0.0), bodies(1, 2)),
+            (9, input(1, true, 0.0, 0.0), bodies(0, 3)),
+            (12, input(2, true, 0.4, 0.05), bodies(2, 1)),
+        ];
+        let lanes: [LaneInput<'_>; LANES] = [
+            Some((cases[0].0, &cases[0].1, &cases[0].2)),
+            Some((cases[1].0, &cases[1].1, &cases[1].2)),
+            Some((cases[2].0, &cases[2].1, &cases[2].2)),
+            None,
+        ];
+        let (mut w, mut cold) = (WideContact::default(), WideCold::default());
+        build_group(&mut w, &mut cold, lanes, up, &soft, &ctx, &states);
+        let (mut r, mut rcold) = (w, cold);
+        for (l, (ci, inp, b)) in cases.iter().enumerate() {
+            let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, &states);
+            let dyn_side = |m: f32, i: f32| m > 0.0 || i > 0.0;
+            pack(
+                &mut r,
+                &mut rcold,
+                l,
+                &cc,
+                dyn_side(b.inv_mass_a, b.inv_i_a),
+                dyn_side(b.inv_mass_b, b.inv_i_b),
+            );
+        }
+        assert_eq!(format!("{w:?}"), format!("{r:?}"));
+        assert_eq!(format!("{cold:?}"), format!("{rcold:?}"));
+        // The cases do what they claim: a carried point sticks, a new one in contact and
+        // slipping slides; the empty
+        // lane carries no mass.
+        assert!(cold.stick[0][0] && !cold.stick[0][1] && cold.fresh[0][1]);
+        assert_eq!(
+            (w.inv_mass_a.0[3], w.inv_mass_b.0[3], w.points[0].normal_mass.0[3]),
+            (0.0, 0.0, 0.0)
+        );
+        assert!(w.any_rolling && cold.any_restitution && w.block.lane(0));
+    }
 }

@@ -346,27 +346,6 @@ pub(crate) fn for_each_mut2<A: Send, B: Send>(
     }
 }
 
-/// Calls `f(first, chunk)` for consecutive chunks of `chunk_len` items (`first`: index of
-/// the chunk's first item), split between the pool's threads when `parallel`.
-pub(crate) fn for_each_chunk_mut<T: Send>(
-    parallel: bool,
-    items: &mut [T],
-    chunk_len: usize,
-    f: impl Fn(usize, &mut [T]) + Sync,
-) {
-    if parallel {
-        use rayon::prelude::*;
-        items
-            .par_chunks_mut(chunk_len)
-            .enumerate()
-            .for_each(|(k, chunk)| f(k * chunk_len, chunk));
-    } else {
-        for (k, chunk) in items.chunks_mut(chunk_len).enumerate() {
-            f(k * chunk_len, chunk);
-        }
-    }
-}
-
 /// `out` = `f` of every item, in order (split between the worker threads if `parallel`);
 /// reuses `out`'s allocation.
 pub(crate) fn map_into<T: Sync, U: Send>(parallel: bool, items: &[T], out: &mut Vec<U>, f: impl Fn(&T) -> U + Sync) {

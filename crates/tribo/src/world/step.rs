@@ -398,11 +398,21 @@ impl World {
                 },
             })
         };
-        // Written in place (no per-step allocation); the rare rejects are dropped after.
-        map_into(ctx.parallel, &self.touching_contacts, &mut candidates, |&ci| {
-            candidate(ci).unwrap_or(Candidate::SKIP)
-        });
-        candidates.retain(|c| c.contact != Candidate::SKIP.contact);
+        // No per-step allocation. Threads: written in place, the rare rejects dropped
+        // after. One thread: pushed straight into the list (no temporary to copy).
+        if ctx.parallel {
+            map_into(true, &self.touching_contacts, &mut candidates, |&ci| {
+                candidate(ci).unwrap_or(Candidate::SKIP)
+            });
+            candidates.retain(|c| c.contact != Candidate::SKIP.contact);
+        } else {
+            candidates.clear();
+            for &ci in &self.touching_contacts {
+                if let Some(c) = candidate(ci) {
+                    candidates.push(c);
+                }
+            }
+        }
         let mut solver = core::mem::take(&mut self.contact_solver);
         solver.up = (-g).normalize_or_zero();
         solver.build(ctx, &self.states, &self.sims, &candidates);
