@@ -295,15 +295,22 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
         let block0 = ok_a.select(xa0, ok_b.select(xb0, zero));
         let block1 = ok_a.select(xa1, (!ok_b & ok_c).select(xc1, zero));
         let found = c.block & (ok_a | ok_b | ok_c | ok_d);
-        // Sequential rows where the block solve does not apply.
-        let seq0 = (lam0 + (-(p0.normal_mass * ms[0] * rhs0) - is[0] * (lam0 - pre0))).max(zero);
-        let new0 = found.select(block0, seq0);
-        apply(c, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(new0 - lam0));
-        let vn1 = relative_velocity(&a, &b, arms[1].0, arms[1].1).dot(n);
-        let seq1 = (lam1 + (-(p1.normal_mass * ms[1] * (vn1 + bias[1])) - is[1] * (lam1 - pre1))).max(zero);
-        let new1 = found.select(block1, seq1);
-        apply(c, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(new1 - lam1));
-        (new0, new1)
+        if found.all() {
+            // Every lane solved as a block: no sequential rows needed.
+            apply(c, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(block0 - lam0));
+            apply(c, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(block1 - lam1));
+            (block0, block1)
+        } else {
+            // Sequential rows where the block solve does not apply.
+            let seq0 = (lam0 + (-(p0.normal_mass * ms[0] * rhs0) - is[0] * (lam0 - pre0))).max(zero);
+            let new0 = found.select(block0, seq0);
+            apply(c, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(new0 - lam0));
+            let vn1 = relative_velocity(&a, &b, arms[1].0, arms[1].1).dot(n);
+            let seq1 = (lam1 + (-(p1.normal_mass * ms[1] * (vn1 + bias[1])) - is[1] * (lam1 - pre1))).max(zero);
+            let new1 = found.select(block1, seq1);
+            apply(c, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(new1 - lam1));
+            (new0, new1)
+        }
     };
     for (p, new) in c.points.iter_mut().zip([new0, new1]) {
         p.normal_impulse = new;
