@@ -382,8 +382,10 @@ pub(crate) fn build_group<S: StateRead>(
     let zero = F4::ZERO;
     let one = F4::splat(1.0);
     let half = F4::splat(0.5);
-    let mut out = WideContact::default();
-    let mut c = WideCold::default();
+    // Written in place (a 1 KiB group built on the stack and copied costs more).
+    *w = WideContact::default();
+    *cold = WideCold::default();
+    let (out, c) = (w, cold);
     // Per-lane inputs (zero in empty lanes and absent points).
     let (mut center_a, mut center_b, mut point) = (V4::default(), V4::default(), [V4::default(); 2]);
     let mut has = [M4::default(); 2];
@@ -536,8 +538,6 @@ pub(crate) fn build_group<S: StateRead>(
     out.i22 = block.select(k11 * inv, zero);
     out.inv_k11 = block.select(one / k11, zero);
     out.inv_k22 = block.select(one / k22, zero);
-    *w = out;
-    *cold = c;
 }
 
 /// Copies a scalar constraint into lane `l` (everything: geometry, masses, state).
