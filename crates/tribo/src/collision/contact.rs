@@ -237,6 +237,31 @@ pub(crate) fn pair_key(a: u32, b: u32) -> u64 {
     ((lo as u64) << 32) | hi as u64
 }
 
+/// A contact record with nothing in it (tests).
+#[cfg(test)]
+pub(crate) fn blank_contact() -> Contact {
+    Contact {
+        shape_a: ShapeId {
+            index: 0,
+            generation: 0,
+        },
+        shape_b: ShapeId {
+            index: 1,
+            generation: 0,
+        },
+        body_a: 0,
+        body_b: 1,
+        manifold: Manifold::default(),
+        points: [PointState::default(); MAX_MANIFOLD_POINTS],
+        material: MixedMaterial::default(),
+        rolling_radius: 0.0,
+        rolling_impulse: 0.0,
+        touching: false,
+        basis: RecycleBasis::default(),
+        outcome: NarrowOutcome::Skipped,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -244,26 +269,7 @@ mod tests {
     use crate::math::Rot;
 
     fn contact() -> Contact {
-        Contact {
-            shape_a: ShapeId {
-                index: 0,
-                generation: 0,
-            },
-            shape_b: ShapeId {
-                index: 1,
-                generation: 0,
-            },
-            body_a: 0,
-            body_b: 1,
-            manifold: Manifold::default(),
-            points: [PointState::default(); MAX_MANIFOLD_POINTS],
-            material: MixedMaterial::default(),
-            rolling_radius: 0.0,
-            rolling_impulse: 0.0,
-            touching: false,
-            basis: RecycleBasis::default(),
-            outcome: NarrowOutcome::Skipped,
-        }
+        blank_contact()
     }
 
     /// A box resting on a ground box and nudged by 0.2 mm and 0.01°: the recycled manifold

@@ -27,11 +27,11 @@ use super::contact_solver::{
     solve_one, store_impulses, warm_start_one, ConstraintBodies, ContactConstraint, ContactInput, StepSoftness,
     MASS_RATIO_GROUP, MAX_LOCAL_SWEEPS,
 };
-use super::contact_wide::{self, WideCold, WideContact, COLORS, DYNAMIC_COLORS};
+use super::contact_wide::{self, StoredContact, WideCold, WideContact, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
 use super::{
-    any_load, for_each_mut2, integrate_position_one, integrate_velocity_one, BodySim, ConstraintSet, SharedState,
-    SpinBarrier, StateCell, StateRead, StepContext,
+    any_load, for_each_mut, for_each_mut2, integrate_position_one, integrate_velocity_one, BodySim, ConstraintSet,
+    SharedState, SpinBarrier, StateCell, StateRead, StepContext,
 };
 use crate::collision::contact::Contact;
 use crate::math::Vec2;
@@ -97,6 +97,8 @@ pub(crate) struct ContactSolver {
     ranges: Vec<(u32, u32)>,
     /// Candidate index of each lane of each group (`u32::MAX`: empty lane).
     lane_candidates: Vec<[u32; LANES]>,
+    /// What each lane stores into its contact (the store's first half, in group order).
+    stored: Vec<[StoredContact; LANES]>,
     // Scratch reused every step.
     colours: Vec<u8>,
     used: Vec<u32>,
@@ -349,10 +351,11 @@ impl ContactSolver {
     }
 
     /// Writes every constraint's impulses and friction state back into its contact
-    /// (`contacts` is the world's contact list), in contact order: `candidates` are sorted
-    /// by contact, so only the solved contacts are visited. With threads, the candidates
-    /// are split into chunks whose contacts are disjoint ranges of the list (each chunk
-    /// writes only its own contacts).
+    /// (`contacts` is the world's contact list), in two halves: the lanes compute what
+    /// they store group by group (reading each group once, in memory order), then the
+    /// contacts copy it in contact order: `candidates` are sorted by contact, so only the
+    /// solved contacts are visited. With threads, both halves are split: by groups, then
+    /// by chunks of candidates whose contacts are disjoint ranges of the list.
     pub fn store<S: StateRead + Sync>(
         &mut self,
         ctx: &StepContext,
@@ -360,19 +363,24 @@ impl ContactSolver {
         candidates: &[Candidate],
         contacts: &mut [Option<Contact>],
     ) {
+        let (wide, cold) = (&self.wide, &self.cold);
+        self.stored.resize(wide.len(), [StoredContact::default(); LANES]);
+        self.stored.truncate(wide.len());
+        for_each_mut(ctx.parallel, &mut self.stored, GROUP_CHUNK, |g, out| {
+            contact_wide::store_group(&wide[g], &cold[g], states, ctx, out);
+        });
         let this = &*self;
         let store_run = |first: usize, cands: &[Candidate], base: usize, contacts: &mut [Option<Contact>]| {
-            // A template whose fields that storing does not read stay as they are.
-            let mut cc = ContactConstraint::default();
             for (k, cand) in cands.iter().enumerate() {
                 let Some(Some(c)) = contacts.get_mut((cand.contact as usize).wrapping_sub(base)) else {
                     continue;
                 };
                 match this.slots.get(first + k) {
                     Some(&Slot::Wide { group, lane }) => {
-                        let g = group as usize;
-                        contact_wide::unpack_for_store(&this.wide[g], &this.cold[g], lane as usize, &mut cc);
-                        store_impulses(&cc, c, states, ctx);
+                        let s = &this.stored[group as usize][lane as usize];
+                        let n = s.count as usize;
+                        c.points[..n].copy_from_slice(&s.points[..n]);
+                        c.rolling_impulse = s.rolling_impulse;
                     }
                     Some(&Slot::Overflow(o)) => {
                         if let Some(oc) = this.overflow.get(o as usize) {

@@ -30,6 +30,7 @@ use super::contact_solver::{
 use super::wide::{F4, LANES, M4, V4};
 use super::Softness;
 use super::{StateCell, StateRead, StepContext};
+use crate::collision::contact::{FrictionState, PointState};
 use crate::math::Vec2;
 
 /// Number of colours (Box2D v3 uses 24, the last for overflow).
@@ -540,6 +541,109 @@ pub(crate) fn build_group<S: StateRead>(
     out.inv_k22 = block.select(one / k22, zero);
 }
 
+/// What the store writes into one contact: its points' persistent states and the rolling
+/// impulse (`contact_solver::store_impulses`, computed from a lane).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct StoredContact {
+    pub points: [PointState; 2],
+    pub rolling_impulse: f32,
+    /// Points written (the manifold's count).
+    pub count: u8,
+}
+
+/// The store stage for four constraints, in group order: exactly what
+/// `contact_solver::store_impulses` computes for each lane (the end-of-step slip velocity
+/// and anchor displacement four lanes at a time, the sums and the stick/slip transitions
+/// lane by lane), written to `out` for the contacts to copy in contact order.
+pub(crate) fn store_group<S: StateRead>(
+    w: &WideContact,
+    cold: &WideCold,
+    states: &[S],
+    ctx: &StepContext,
+    out: &mut [StoredContact; LANES],
+) {
+    let a = gather(states, &w.index_a);
+    let b = gather(states, &w.index_b);
+    let d = b.dp - a.dp;
+    let n = w.normal;
+    let t = V4 { x: n.y, y: -n.x };
+    let mut vt = [F4::ZERO; 2];
+    let mut disp = [F4::ZERO; 2];
+    for i in 0..2 {
+        let p = &w.points[i];
+        let (r_a, r_b) = lever_arms(w, d, p.r_a, p.r_b);
+        vt[i] = relative_velocity(&a, &b, r_a, r_b).dot(t) - w.tangent_speed;
+        disp[i] = anchor_displacement(&a, &b, d, p.r_a, p.r_b).dot(t);
+    }
+    for (l, o) in out.iter_mut().enumerate() {
+        let count = (cold.count[l] as usize).min(2);
+        o.count = count as u8;
+        o.rolling_impulse = w.rolling_impulse.0[l];
+        let share = if count == 2 { 0.5 } else { 1.0 };
+        let saturated = w.saturated.lane(l);
+        let (tangent, total_tangent) = (share * w.tangent_impulse.0[l], share * w.total_tangent_impulse.0[l]);
+        let (mut sum_t, mut sum_n) = (0.0f32, 0.0f32);
+        for p in &w.points[..count] {
+            sum_t += tangent;
+            sum_n += p.normal_impulse.0[l];
+        }
+        let patch_saturated = sum_t.abs() >= 0.999 * w.mu_s.0[l] * sum_n && count > 0 && saturated;
+        let sum_total_t: f32 = (0..count).map(|_| total_tangent).sum();
+        let sum_total_n: f32 = w.points[..count].iter().map(|p| p.total_normal_impulse.0[l]).sum();
+        let tangent_speed = w.tangent_speed.0[l];
+        for i in 0..count {
+            let wp = &w.points[i];
+            let (normal, total_normal, max) = (
+                wp.normal_impulse.0[l],
+                wp.total_normal_impulse.0[l],
+                wp.max_normal_impulse.0[l],
+            );
+            let (was_stick, fresh) = (cold.stick[i][l], cold.fresh[i][l]);
+            let slip_speed = vt[i].0[l].abs();
+            let loaded = max > 0.0;
+            let mut stick = was_stick;
+            if loaded {
+                if stick && patch_saturated && slip_speed > ctx.stick_speed {
+                    stick = false;
+                } else if !stick && slip_speed < ctx.stick_speed {
+                    stick = true;
+                }
+            }
+            o.points[i] = PointState {
+                normal_impulse: normal,
+                tangent_impulse: tangent,
+                total_normal_impulse: total_normal,
+                total_tangent_impulse: if count == 2 && sum_total_n > 0.0 {
+                    sum_total_t * total_normal / sum_total_n
+                } else {
+                    total_tangent
+                },
+                max_normal_impulse: max,
+                state: if stick {
+                    FrictionState::Stick
+                } else {
+                    FrictionState::Slip
+                },
+                fresh: false,
+                drift: if stick && was_stick && loaded {
+                    disp[i].0[l] + cold.base_drift[i][l] - tangent_speed * ctx.dt
+                } else {
+                    0.0
+                },
+                slip_speed,
+                preload: if max <= 0.0 {
+                    0.0
+                } else if fresh {
+                    normal
+                } else {
+                    wp.preload.0[l]
+                },
+                approach_velocity: wp.approach.0[l],
+            };
+        }
+    }
+}
+
 /// Copies a scalar constraint into lane `l` (everything: geometry, masses, state).
 pub(crate) fn pack(
     w: &mut WideContact,
@@ -760,36 +864,11 @@ pub(crate) fn unpack_full(w: &WideContact, cold: &WideCold, l: usize) -> Contact
     cc
 }
 
-/// Rebuilds only what storing impulses reads of lane `l` (see
-/// `contact_solver::store_impulses`): bodies, normal, friction data, anchors and state.
-pub(crate) fn unpack_for_store(w: &WideContact, cold: &WideCold, l: usize, cc: &mut ContactConstraint) {
-    let count = cold.count[l] as usize;
-    cc.index_a = w.index_a[l];
-    cc.index_b = w.index_b[l];
-    cc.contact = cold.contact[l];
-    cc.normal = Vec2::new(w.normal.x.0[l], w.normal.y.0[l]);
-    cc.mu_s = w.mu_s.0[l];
-    cc.tangent_speed = w.tangent_speed.0[l];
-    cc.split = w.split.0[l];
-    cc.count = count;
-    for i in 0..count {
-        let wp = &w.points[i];
-        let cp = &mut cc.points[i];
-        cp.r_a = Vec2::new(wp.r_a.x.0[l], wp.r_a.y.0[l]);
-        cp.r_b = Vec2::new(wp.r_b.x.0[l], wp.r_b.y.0[l]);
-        cp.base_drift = cold.base_drift[i][l];
-        cp.preload = wp.preload.0[l];
-        cp.stick = cold.stick[i][l];
-        cp.fresh = cold.fresh[i][l];
-    }
-    unpack_state(w, l, cc);
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::math::Rot;
-    use crate::solver::contact_solver::{build_constraint, InputPoint};
+    use crate::solver::contact_solver::{build_constraint, store_impulses, InputPoint};
     use crate::solver::BodyState;
 
     fn input(count: usize, fresh: bool, restitution: f32, rolling: f32) -> ContactInput {
@@ -839,8 +918,27 @@ mod tests {
     /// one-point manifolds, a static side, new points (whose stick/slip state is decided
     /// from the step-start velocities: one in contact and slipping, one not), restitution,
     /// rolling resistance and an empty lane.
-    #[test]
-    fn wide_build_equals_scalar_build_and_pack() {
+    struct Fixture {
+        ctx: StepContext,
+        soft: StepSoftness,
+        states: Vec<BodyState>,
+        up: Vec2,
+        cases: [(u32, ContactInput, ConstraintBodies); 3],
+    }
+
+    impl Fixture {
+        fn lanes(&self) -> [LaneInput<'_>; LANES] {
+            let c = &self.cases;
+            [
+                Some((c[0].0, &c[0].1, &c[0].2)),
+                Some((c[1].0, &c[1].1, &c[1].2)),
+                Some((c[2].0, &c[2].1, &c[2].2)),
+                None,
+            ]
+        }
+    }
+
+    fn fixture() -> Fixture {
         let ctx = StepContext {
             dt: 1.0 / 60.0,
             h: 1.0 / 240.0,
@@ -874,17 +972,24 @@ mod tests {
             (9, input(1, true, 0.0, 0.0), bodies(0, 3)),
             (12, input(2, true, 0.4, 0.05), bodies(2, 1)),
         ];
-        let lanes: [LaneInput<'_>; LANES] = [
-            Some((cases[0].0, &cases[0].1, &cases[0].2)),
-            Some((cases[1].0, &cases[1].1, &cases[1].2)),
-            Some((cases[2].0, &cases[2].1, &cases[2].2)),
-            None,
-        ];
+        Fixture {
+            ctx,
+            soft,
+            states,
+            up,
+            cases,
+        }
+    }
+
+    #[test]
+    fn wide_build_equals_scalar_build_and_pack() {
+        let f = fixture();
+        let (ctx, soft, states, up, cases) = (f.ctx, f.soft, &f.states, f.up, &f.cases);
         let (mut w, mut cold) = (WideContact::default(), WideCold::default());
-        build_group(&mut w, &mut cold, lanes, up, &soft, &ctx, &states);
+        build_group(&mut w, &mut cold, f.lanes(), up, &soft, &ctx, states);
         let (mut r, mut rcold) = (w, cold);
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
-            let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, &states);
+            let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
             let dyn_side = |m: f32, i: f32| m > 0.0 || i > 0.0;
             pack(
                 &mut r,
@@ -906,5 +1011,46 @@ mod tests {
             (0.0, 0.0, 0.0)
         );
         assert!(w.any_rolling && cold.any_restitution && w.block.lane(0));
+    }
+
+    /// The store's wide half must write into each contact exactly what the scalar store
+    /// writes from the same lane (impulses, totals, the patch's split of the friction
+    /// total, preload, slip speed, drift and the stick/slip transition): after a solver
+    /// pass has changed the impulses and the bodies have moved, both stores are run from
+    /// the same lanes and compared field by field.
+    #[test]
+    fn wide_store_equals_scalar_store() {
+        let f = fixture();
+        let (mut w, mut cold) = (WideContact::default(), WideCold::default());
+        build_group(&mut w, &mut cold, f.lanes(), f.up, &f.soft, &f.ctx, &f.states);
+        let cells: Vec<core::cell::Cell<BodyState>> = f.states.iter().map(|&s| core::cell::Cell::new(s)).collect();
+        solve::<false, _>(&mut w, &cells, &f.ctx, f.ctx.h);
+        let moved: Vec<BodyState> = cells
+            .iter()
+            .map(|c| {
+                let mut s = c.get();
+                s.dp = Vec2::new(1e-3 * s.v.x, -2e-3);
+                s.dq = Rot::from_angle(1e-3 * s.w);
+                s
+            })
+            .collect();
+        let mut out = [StoredContact::default(); LANES];
+        store_group(&w, &cold, &moved, &f.ctx, &mut out);
+        let (mut slipped, mut pushed) = (false, false);
+        for l in 0..3 {
+            let cc = unpack_full(&w, &cold, l);
+            let mut c = crate::collision::contact::blank_contact();
+            store_impulses(&cc, &mut c, &moved, &f.ctx);
+            let n = cc.count;
+            assert_eq!(out[l].count as usize, n);
+            assert_eq!(out[l].points[..n], c.points[..n], "lane {l}");
+            assert_eq!(out[l].rolling_impulse.to_bits(), c.rolling_impulse.to_bits());
+            slipped |= c.points[..n].iter().any(|p| p.state == FrictionState::Slip);
+            pushed |= c.points[..n]
+                .iter()
+                .any(|p| p.total_normal_impulse > 0.0 && p.drift != 0.0);
+        }
+        assert!(slipped, "the fixture exercises a sliding point");
+        assert!(pushed, "and a loaded sticking point with drift");
     }
 }
