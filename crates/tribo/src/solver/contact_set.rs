@@ -27,10 +27,10 @@ use super::contact_solver::{
     solve_one, store_impulses, warm_start_one, ConstraintBodies, ContactConstraint, ContactInput, StepSoftness,
     MASS_RATIO_GROUP, MAX_LOCAL_SWEEPS,
 };
-use super::contact_wide::{self, StoredContact, WideCold, WideContact, COLORS, DYNAMIC_COLORS};
+use super::contact_wide::{self, StoredContact, WideCold, WideContact, WideHead, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
 use super::{
-    any_load, for_each_mut, for_each_mut2, integrate_position_one, integrate_velocity_one, BodySim, ConstraintSet,
+    any_load, for_each_mut, for_each_mut3, integrate_position_one, integrate_velocity_one, BodySim, ConstraintSet,
     SharedState, SpinBarrier, StateCell, StateRead, StepContext,
 };
 use crate::collision::contact::Contact;
@@ -83,6 +83,8 @@ struct Group {
 pub(crate) struct ContactSolver {
     /// Unit vector against gravity (zero without gravity).
     pub up: Vec2,
+    /// What the warm start reads of each group (parallel to `wide`).
+    head: Vec<WideHead>,
     wide: Vec<WideContact>,
     cold: Vec<WideCold>,
     /// Constraints that found no colour, whole (solved first in each pass).
@@ -115,7 +117,7 @@ const CONTACT_STORE_CHUNK: usize = 512;
 const OVERFLOW: u8 = u8::MAX;
 
 /// The colours' runs of `wide` as separate mutable slices (`ranges` ascending, disjoint).
-fn split_ranges<'a>(wide: &'a mut [WideContact], ranges: &[(u32, u32)]) -> Vec<&'a mut [WideContact]> {
+fn split_ranges<'a, T>(wide: &'a mut [T], ranges: &[(u32, u32)]) -> Vec<&'a mut [T]> {
     let mut out = Vec::with_capacity(ranges.len());
     let mut rest = wide;
     let mut at = 0usize;
@@ -212,6 +214,8 @@ impl ContactSolver {
             }
         }
         // Every lane is written whole below (packed or cleared): no memset.
+        self.head.resize(groups as usize, WideHead::default());
+        self.head.truncate(groups as usize);
         self.wide.resize(groups as usize, WideContact::default());
         self.cold.resize(groups as usize, WideCold::default());
         self.wide.truncate(groups as usize);
@@ -261,18 +265,19 @@ impl ContactSolver {
         // 4. Build and pack the coloured constraints, four lanes per task.
         let up = self.up;
         let lane_candidates = &self.lane_candidates;
-        for_each_mut2(
+        for_each_mut3(
             ctx.parallel,
+            &mut self.head,
             &mut self.wide,
             &mut self.cold,
             GROUP_CHUNK,
-            |g, w, cold| {
+            |g, h, w, cold| {
                 let lanes = lane_candidates[g].map(|i| {
                     candidates
                         .get(i as usize)
                         .map(|cand| (cand.contact, &cand.input, &cand.bodies))
                 });
-                contact_wide::build_group(w, cold, lanes, up, &soft, ctx, states);
+                contact_wide::build_group(h, w, cold, lanes, up, &soft, ctx, states);
             },
         );
         for (g, cold) in self.cold.iter().enumerate() {
@@ -326,7 +331,7 @@ impl ContactSolver {
         match slot {
             Slot::Wide { group, lane } => {
                 let g = group as usize;
-                contact_wide::unpack_full(&self.wide[g], &self.cold[g], lane as usize)
+                contact_wide::unpack_full(&self.head[g], &self.wide[g], &self.cold[g], lane as usize)
             }
             Slot::Overflow(i) => self.overflow[i as usize],
         }
@@ -338,12 +343,12 @@ impl ContactSolver {
         match slot {
             Slot::Wide { group, lane } => {
                 let g = group as usize;
-                let w = &mut self.wide[g];
+                let (h, w) = (&mut self.head[g], &mut self.wide[g]);
                 if full {
-                    let (da, db) = (w.write_a[lane as usize], w.write_b[lane as usize]);
-                    contact_wide::pack(w, &mut self.cold[g], lane as usize, cc, da, db);
+                    let (da, db) = (h.write_a[lane as usize], h.write_b[lane as usize]);
+                    contact_wide::pack(h, w, &mut self.cold[g], lane as usize, cc, da, db);
                 } else {
-                    contact_wide::pack_state(w, lane as usize, cc);
+                    contact_wide::pack_state(h, w, lane as usize, cc);
                 }
             }
             Slot::Overflow(i) => self.overflow[i as usize] = *cc,
@@ -363,11 +368,11 @@ impl ContactSolver {
         candidates: &[Candidate],
         contacts: &mut [Option<Contact>],
     ) {
-        let (wide, cold) = (&self.wide, &self.cold);
+        let (head, wide, cold) = (&self.head, &self.wide, &self.cold);
         self.stored.resize(wide.len(), [StoredContact::default(); LANES]);
         self.stored.truncate(wide.len());
         for_each_mut(ctx.parallel, &mut self.stored, GROUP_CHUNK, |g, out| {
-            contact_wide::store_group(&wide[g], &cold[g], states, ctx, out);
+            contact_wide::store_group(&head[g], &wide[g], &cold[g], states, ctx, out);
         });
         let this = &*self;
         let store_run = |first: usize, cands: &[Candidate], base: usize, contacts: &mut [Option<Contact>]| {
@@ -449,9 +454,9 @@ impl ConstraintSet for ContactSolver {
             warm_start_one(cc, states);
         }
         for &(start, end) in &self.ranges {
-            let colour = &mut self.wide[start as usize..end as usize];
-            S::for_each_mut(states, colour, GROUP_CHUNK, |_, w, states| {
-                contact_wide::warm_start(w, states)
+            let colour = &mut self.head[start as usize..end as usize];
+            S::for_each_mut(states, colour, GROUP_CHUNK, |_, h, states| {
+                contact_wide::warm_start(h, states)
             });
         }
     }
@@ -462,14 +467,17 @@ impl ConstraintSet for ContactSolver {
         }
         // Colour after colour; the groups of one colour share no moving body.
         for &(start, end) in &self.ranges {
-            let colour = &mut self.wide[start as usize..end as usize];
+            let (heads, colour) = (
+                &mut self.head[start as usize..end as usize],
+                &mut self.wide[start as usize..end as usize],
+            );
             if use_bias {
-                S::for_each_mut(states, colour, GROUP_CHUNK, |_, w, states| {
-                    contact_wide::solve::<true, S>(w, states, ctx, elapsed)
+                S::for_each_mut2(states, heads, colour, GROUP_CHUNK, |_, h, w, states| {
+                    contact_wide::solve::<true, S>(h, w, states, ctx, elapsed)
                 });
             } else {
-                S::for_each_mut(states, colour, GROUP_CHUNK, |_, w, states| {
-                    contact_wide::solve::<false, S>(w, states, ctx, elapsed)
+                S::for_each_mut2(states, heads, colour, GROUP_CHUNK, |_, h, w, states| {
+                    contact_wide::solve::<false, S>(h, w, states, ctx, elapsed)
                 });
             }
         }
@@ -528,9 +536,9 @@ impl ConstraintSet for ContactSolver {
             }
             for l in 0..LANES {
                 if self.cold[g].count[l] > 0 && self.cold[g].restitution[l] > 0.0 {
-                    let mut cc = contact_wide::unpack_full(&self.wide[g], &self.cold[g], l);
+                    let mut cc = contact_wide::unpack_full(&self.head[g], &self.wide[g], &self.cold[g], l);
                     restitution_one(&mut cc, states);
-                    contact_wide::pack_state(&mut self.wide[g], l, &cc);
+                    contact_wide::pack_state(&mut self.head[g], &mut self.wide[g], l, &cc);
                 }
             }
         }
@@ -550,22 +558,28 @@ impl ContactSolver {
         if threads < 2 || !self.overflow.is_empty() || !self.groups.is_empty() || self.wide.is_empty() {
             return false;
         }
-        let parts: Vec<Vec<std::sync::Mutex<&mut [WideContact]>>> = split_ranges(&mut self.wide, &self.ranges)
+        type Part<'a> = std::sync::Mutex<(&'a mut [WideHead], &'a mut [WideContact])>;
+        let parts: Vec<Vec<Part<'_>>> = split_ranges(&mut self.head, &self.ranges)
             .into_iter()
-            .map(|c| {
+            .zip(split_ranges(&mut self.wide, &self.ranges))
+            .map(|(h, c)| {
                 let chunk = c.len().div_ceil(threads).max(1);
-                c.chunks_mut(chunk).map(std::sync::Mutex::new).collect()
+                h.chunks_mut(chunk)
+                    .zip(c.chunks_mut(chunk))
+                    .map(std::sync::Mutex::new)
+                    .collect()
             })
             .collect();
         let bodies_per_thread = sims.len().div_ceil(threads).max(1);
         let barrier = SpinBarrier::new(threads);
         let times_out = std::sync::Mutex::new([0.0f32; 5]);
-        let each_colour = |k: usize, f: &dyn Fn(&mut WideContact)| {
+        let each_colour = |k: usize, f: &dyn Fn(&mut WideHead, &mut WideContact)| {
             for colour in &parts {
                 if let Some(part) = colour.get(k) {
                     let mut guard = part.lock().unwrap_or_else(|e| e.into_inner());
-                    for w in guard.iter_mut() {
-                        f(w);
+                    let (heads, wides) = &mut *guard;
+                    for (h, w) in heads.iter_mut().zip(wides.iter_mut()) {
+                        f(h, w);
                     }
                 }
                 barrier.wait();
@@ -583,10 +597,10 @@ impl ContactSolver {
                 }
                 barrier.wait();
                 t[0] += lap.lap();
-                each_colour(k, &|w| contact_wide::warm_start(w, states));
+                each_colour(k, &|h, _| contact_wide::warm_start(h, states));
                 t[1] += lap.lap();
-                each_colour(k, &|w| {
-                    contact_wide::solve::<true, SharedState>(w, states, ctx, elapsed)
+                each_colour(k, &|h, w| {
+                    contact_wide::solve::<true, SharedState>(h, w, states, ctx, elapsed)
                 });
                 t[2] += lap.lap();
                 for b in bodies.clone() {
@@ -594,8 +608,8 @@ impl ContactSolver {
                 }
                 barrier.wait();
                 t[3] += lap.lap();
-                each_colour(k, &|w| {
-                    contact_wide::solve::<false, SharedState>(w, states, ctx, elapsed + ctx.h)
+                each_colour(k, &|h, w| {
+                    contact_wide::solve::<false, SharedState>(h, w, states, ctx, elapsed + ctx.h)
                 });
                 t[4] += lap.lap();
             }
@@ -610,7 +624,10 @@ impl ContactSolver {
     /// Refreshes a copy's state from its slot (the coloured passes changed it).
     fn sync_from(&self, slot: Slot, cc: &mut ContactConstraint) {
         match slot {
-            Slot::Wide { group, lane } => contact_wide::unpack_state(&self.wide[group as usize], lane as usize, cc),
+            Slot::Wide { group, lane } => {
+                let g = group as usize;
+                contact_wide::unpack_state(&self.head[g], &self.wide[g], lane as usize, cc)
+            }
             Slot::Overflow(i) => *cc = self.overflow[i as usize],
         }
     }

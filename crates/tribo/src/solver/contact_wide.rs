@@ -39,41 +39,61 @@ pub(crate) const COLORS: usize = 24;
 /// are for constraints with a static or kinematic side).
 pub(crate) const DYNAMIC_COLORS: usize = 20;
 
-/// One point of four constraints.
+/// One point of four constraints: what only the solve passes read (the warm start's part
+/// is in [`HeadPoint`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WidePoint {
-    pub r_a: V4,
-    pub r_b: V4,
     pub base_separation: F4,
     pub normal_mass: F4,
-    pub normal_impulse: F4,
     pub preload: F4,
     pub total_normal_impulse: F4,
     pub max_normal_impulse: F4,
     pub approach: F4,
+}
+
+/// One point of four constraints: what the warm start reads and writes.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct HeadPoint {
+    pub r_a: V4,
+    pub r_b: V4,
+    pub normal_impulse: F4,
     pub substep_vn: F4,
 }
 
-/// Four contact constraints, one per lane (see the module docs).
+/// The part of four constraints the warm start needs (bodies, normal, masses, anchors,
+/// impulses), kept in its own array: the warm start streams only these ~400 bytes per
+/// group instead of the whole constraint (it is bound by memory traffic, not arithmetic).
 #[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct WideContact {
+pub(crate) struct WideHead {
     pub index_a: [u32; LANES],
     pub index_b: [u32; LANES],
     /// Whether the lane's body A (B) is dynamic, i.e. written back by the scatter.
     pub write_a: [bool; LANES],
     pub write_b: [bool; LANES],
+    pub any_rolling: bool,
     pub normal: V4,
     pub inv_mass_a: F4,
     pub inv_i_a: F4,
     pub inv_mass_b: F4,
     pub inv_i_b: F4,
     pub split: F4,
+    pub points: [HeadPoint; 2],
+    /// Friction impulse of the row (sum over the points) [N·s].
+    pub tangent_impulse: F4,
+    /// Share of the row's friction impulse each point reports (½, ½ or 1, 0).
+    pub tangent_share: [F4; 2],
+    pub rolling_impulse: F4,
+}
+
+/// The rest of four contact constraints, one per lane (see the module docs): what only
+/// the solve passes read.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct WideContact {
     pub mu_s: F4,
     pub mu_d: F4,
     pub tangent_speed: F4,
     pub rolling_resistance: F4,
     pub rolling_mass: F4,
-    pub rolling_impulse: F4,
     pub bias_rate: F4,
     pub mass_scale: F4,
     pub impulse_scale: F4,
@@ -95,13 +115,8 @@ pub(crate) struct WideContact {
     pub tangent_mass: F4,
     pub base_drift: F4,
     pub stick: M4,
-    /// Friction impulse of the row (sum over the points) [N·s].
-    pub tangent_impulse: F4,
     pub total_tangent_impulse: F4,
     pub saturated: M4,
-    /// Share of the row's friction impulse each point reports (½, ½ or 1, 0).
-    pub tangent_share: [F4; 2],
-    pub any_rolling: bool,
 }
 
 /// The parts of four constraints the substeps do not touch (kept apart so the hot
@@ -167,7 +182,7 @@ fn scatter<S: StateCell>(states: &[S], idx: &[u32; LANES], write: &[bool; LANES]
 /// Lever arms of a pass (the anchors moved to their common point, see
 /// `contact_solver::lever_arms`).
 #[inline(always)]
-fn lever_arms(c: &WideContact, d: V4, r_a: V4, r_b: V4) -> (V4, V4) {
+fn lever_arms(c: &WideHead, d: V4, r_a: V4, r_b: V4) -> (V4, V4) {
     let one = F4::splat(1.0);
     (r_a + d.scale(c.split), r_b - d.scale(one - c.split))
 }
@@ -186,7 +201,7 @@ fn relative_velocity(a: &WideBody, b: &WideBody, r_a: V4, r_b: V4) -> V4 {
 }
 
 #[inline(always)]
-fn apply(c: &WideContact, a: &mut WideBody, b: &mut WideBody, r_a: V4, r_b: V4, p: V4) {
+fn apply(c: &WideHead, a: &mut WideBody, b: &mut WideBody, r_a: V4, r_b: V4, p: V4) {
     a.v = a.v - p.scale(c.inv_mass_a);
     a.w -= c.inv_i_a * r_a.cross(p);
     b.v = b.v + p.scale(c.inv_mass_b);
@@ -202,7 +217,7 @@ fn anchor_displacement(a: &WideBody, b: &WideBody, d: V4, r_a: V4, r_b: V4) -> V
 
 /// Re-applies the accumulated impulses at the start of a substep and records each point's
 /// normal velocity before them (restitution's impact speed).
-pub(crate) fn warm_start<S: StateCell>(c: &mut WideContact, states: &[S]) {
+pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
     let mut a = gather(states, &c.index_a);
     let mut b = gather(states, &c.index_b);
     let d = b.dp - a.dp;
@@ -231,15 +246,16 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideContact, states: &[S]) {
 /// One pass over four constraints: normal rows (block or sequential), the friction row,
 /// rolling resistance in the relax pass.
 pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
+    h: &mut WideHead,
     c: &mut WideContact,
     states: &[S],
     ctx: &StepContext,
     elapsed: f32,
 ) {
-    let mut a = gather(states, &c.index_a);
-    let mut b = gather(states, &c.index_b);
+    let mut a = gather(states, &h.index_a);
+    let mut b = gather(states, &h.index_b);
     let d = b.dp - a.dp;
-    let n = c.normal;
+    let n = h.normal;
     let zero = F4::ZERO;
     let one = F4::splat(1.0);
     let push = F4::splat(ctx.push_speed);
@@ -251,9 +267,9 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     let mut ms = [zero; 2];
     let mut is = [zero; 2];
     for i in 0..2 {
-        let p = &c.points[i];
-        arms[i] = lever_arms(c, d, p.r_a, p.r_b);
-        let s = anchor_displacement(&a, &b, d, p.r_a, p.r_b).dot(n) + p.base_separation;
+        let (hp, p) = (&h.points[i], &c.points[i]);
+        arms[i] = lever_arms(h, d, hp.r_a, hp.r_b);
+        let s = anchor_displacement(&a, &b, d, hp.r_a, hp.r_b).dot(n) + p.base_separation;
         let speculative = s.gt(zero);
         let (soft_bias, soft_ms, soft_is) = if USE_BIAS {
             ((c.bias_rate * s).max(-push), c.mass_scale, c.impulse_scale)
@@ -266,7 +282,7 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
         vn[i] = relative_velocity(&a, &b, arms[i].0, arms[i].1).dot(n);
     }
     let [p0, p1] = &c.points;
-    let (lam0, lam1) = (p0.normal_impulse, p1.normal_impulse);
+    let (lam0, lam1) = (h.points[0].normal_impulse, h.points[1].normal_impulse);
     let (pre0, pre1) = (p0.preload, p1.preload);
     // The 2×2 block LCP (contact_solver::solve_block), all four cases in every lane.
     let rhs0 = vn[0] + bias[0];
@@ -278,8 +294,8 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     let ok_a = xa0.ge(zero) & xa1.ge(zero);
     let (new0, new1) = if (ok_a & c.block).all() {
         // Common case (a resting face): both points active in every lane.
-        apply(c, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(xa0 - lam0));
-        apply(c, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(xa1 - lam1));
+        apply(h, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(xa0 - lam0));
+        apply(h, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(xa1 - lam1));
         (xa0, xa1)
     } else {
         let r0 = rhs0 - c.k12 * lam1;
@@ -298,26 +314,26 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
         let found = c.block & (ok_a | ok_b | ok_c | ok_d);
         if found.all() {
             // Every lane solved as a block: no sequential rows needed.
-            apply(c, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(block0 - lam0));
-            apply(c, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(block1 - lam1));
+            apply(h, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(block0 - lam0));
+            apply(h, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(block1 - lam1));
             (block0, block1)
         } else {
             // Sequential rows where the block solve does not apply.
             let seq0 = (lam0 + (-(p0.normal_mass * ms[0] * rhs0) - is[0] * (lam0 - pre0))).max(zero);
             let new0 = found.select(block0, seq0);
-            apply(c, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(new0 - lam0));
+            apply(h, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(new0 - lam0));
             let vn1 = relative_velocity(&a, &b, arms[1].0, arms[1].1).dot(n);
             let seq1 = (lam1 + (-(p1.normal_mass * ms[1] * (vn1 + bias[1])) - is[1] * (lam1 - pre1))).max(zero);
             let new1 = found.select(block1, seq1);
-            apply(c, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(new1 - lam1));
+            apply(h, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(new1 - lam1));
             (new0, new1)
         }
     };
-    for (p, new) in c.points.iter_mut().zip([new0, new1]) {
-        p.normal_impulse = new;
+    for ((p, hp), new) in c.points.iter_mut().zip(h.points.iter_mut()).zip([new0, new1]) {
+        hp.normal_impulse = new;
         p.max_normal_impulse = p.max_normal_impulse.max(new);
-        let lower = new.gt(zero) & p.substep_vn.lt(p.approach);
-        p.approach = lower.select(p.substep_vn, p.approach);
+        let lower = new.gt(zero) & hp.substep_vn.lt(p.approach);
+        p.approach = lower.select(hp.substep_vn, p.approach);
     }
     let pushed = (new0.gt(zero) | new1.gt(zero)).to_unit();
     a.touched = a.touched.max(pushed);
@@ -325,7 +341,7 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
 
     // Friction row (contact_solver::solve_friction).
     let t = V4 { x: n.y, y: -n.x };
-    let (r_a, r_b) = lever_arms(c, d, c.friction_r_a, c.friction_r_b);
+    let (r_a, r_b) = lever_arms(h, d, c.friction_r_a, c.friction_r_b);
     let mu = c.stick.select(c.mu_s, c.mu_d);
     let limit = mu * (new0 + new1);
     let vt = relative_velocity(&a, &b, r_a, r_b).dot(t) - c.tangent_speed;
@@ -337,29 +353,29 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     } else {
         zero
     };
-    let old = c.tangent_impulse;
+    let old = h.tangent_impulse;
     let unclamped = old + -(c.tangent_mass * (vt + fbias));
     let new = unclamped.clamp(-limit, limit);
-    apply(c, &mut a, &mut b, r_a, r_b, t.scale(new - old));
-    c.tangent_impulse = new;
+    apply(h, &mut a, &mut b, r_a, r_b, t.scale(new - old));
+    h.tangent_impulse = new;
     if !USE_BIAS {
         // The relax pass ends the substep: add its impulses to the step totals.
         c.points[0].total_normal_impulse += new0;
         c.points[1].total_normal_impulse += new1;
         c.total_tangent_impulse += new;
         c.saturated = limit.gt(zero) & unclamped.abs().gt(limit);
-        if c.any_rolling {
+        if h.any_rolling {
             let rlimit = c.rolling_resistance * (new0 + new1);
             let imp = -(c.rolling_mass * (b.w - a.w));
-            let rnew = (c.rolling_impulse + imp).clamp(-rlimit, rlimit);
-            let delta = rnew - c.rolling_impulse;
-            c.rolling_impulse = rnew;
-            a.w -= c.inv_i_a * delta;
-            b.w += c.inv_i_b * delta;
+            let rnew = (h.rolling_impulse + imp).clamp(-rlimit, rlimit);
+            let delta = rnew - h.rolling_impulse;
+            h.rolling_impulse = rnew;
+            a.w -= h.inv_i_a * delta;
+            b.w += h.inv_i_b * delta;
         }
     }
-    scatter(states, &c.index_a, &c.write_a, &a);
-    scatter(states, &c.index_b, &c.write_b, &b);
+    scatter(states, &h.index_a, &h.write_a, &a);
+    scatter(states, &h.index_b, &h.write_b, &b);
 }
 
 /// One lane's constraint to build: its contact index, solver input and bodies.
@@ -370,7 +386,9 @@ pub(crate) type LaneInput<'a> = Option<(u32, &'a ContactInput, &'a ConstraintBod
 /// same order), but the masses, the 2×2 block and the friction row are computed four lanes
 /// at a time and the group is written whole, not field by field per lane. An empty lane
 /// has the static body on both sides, no mass and no impulse: solving it changes nothing.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn build_group<S: StateRead>(
+    head: &mut WideHead,
     w: &mut WideContact,
     cold: &mut WideCold,
     lanes: [LaneInput<'_>; LANES],
@@ -384,9 +402,10 @@ pub(crate) fn build_group<S: StateRead>(
     let one = F4::splat(1.0);
     let half = F4::splat(0.5);
     // Written in place (a 1 KiB group built on the stack and copied costs more).
+    *head = WideHead::default();
     *w = WideContact::default();
     *cold = WideCold::default();
-    let (out, c) = (w, cold);
+    let (hd, out, c) = (head, w, cold);
     // Per-lane inputs (zero in empty lanes and absent points).
     let (mut center_a, mut center_b, mut point) = (V4::default(), V4::default(), [V4::default(); 2]);
     let mut has = [M4::default(); 2];
@@ -404,16 +423,16 @@ pub(crate) fn build_group<S: StateRead>(
         c.restitution_threshold[l] = input.restitution_threshold;
         c.any_restitution |= input.restitution > 0.0;
         c.height[l] = if count > 0 { input.points[0].point.dot(up) } else { 0.0 };
-        out.index_a[l] = b.index_a;
-        out.index_b[l] = b.index_b;
-        out.write_a[l] = (b.inv_mass_a > 0.0 || b.inv_i_a > 0.0) && b.index_a != 0;
-        out.write_b[l] = (b.inv_mass_b > 0.0 || b.inv_i_b > 0.0) && b.index_b != 0;
-        out.normal.x.0[l] = input.normal.x;
-        out.normal.y.0[l] = input.normal.y;
-        out.inv_mass_a.0[l] = b.inv_mass_a;
-        out.inv_i_a.0[l] = b.inv_i_a;
-        out.inv_mass_b.0[l] = b.inv_mass_b;
-        out.inv_i_b.0[l] = b.inv_i_b;
+        hd.index_a[l] = b.index_a;
+        hd.index_b[l] = b.index_b;
+        hd.write_a[l] = (b.inv_mass_a > 0.0 || b.inv_i_a > 0.0) && b.index_a != 0;
+        hd.write_b[l] = (b.inv_mass_b > 0.0 || b.inv_i_b > 0.0) && b.index_b != 0;
+        hd.normal.x.0[l] = input.normal.x;
+        hd.normal.y.0[l] = input.normal.y;
+        hd.inv_mass_a.0[l] = b.inv_mass_a;
+        hd.inv_i_a.0[l] = b.inv_i_a;
+        hd.inv_mass_b.0[l] = b.inv_mass_b;
+        hd.inv_i_b.0[l] = b.inv_i_b;
         center_a.x.0[l] = b.center_a.x;
         center_a.y.0[l] = b.center_a.y;
         center_b.x.0[l] = b.center_b.x;
@@ -423,8 +442,8 @@ pub(crate) fn build_group<S: StateRead>(
         out.tangent_speed.0[l] = input.tangent_speed;
         out.rolling_resistance.0[l] = input.rolling_resistance;
         let rolling_impulse = if warm { input.rolling_impulse } else { 0.0 };
-        out.rolling_impulse.0[l] = rolling_impulse;
-        out.any_rolling |= input.rolling_resistance > 0.0 || rolling_impulse != 0.0;
+        hd.rolling_impulse.0[l] = rolling_impulse;
+        hd.any_rolling |= input.rolling_resistance > 0.0 || rolling_impulse != 0.0;
         // Contacts with static bodies are twice as stiff (Box2D v3's static softness).
         let ps = if b.index_a == 0 || b.index_b == 0 {
             soft.static_contact
@@ -452,7 +471,7 @@ pub(crate) fn build_group<S: StateRead>(
             let wp = &mut out.points[i];
             wp.base_separation.0[l] = ip.separation;
             if warm {
-                wp.normal_impulse.0[l] = ip.normal_impulse;
+                hd.points[i].normal_impulse.0[l] = ip.normal_impulse;
                 wp.preload.0[l] = ip.preload;
                 ts[i] = ip.tangent_impulse;
             }
@@ -471,18 +490,18 @@ pub(crate) fn build_group<S: StateRead>(
         // Summed as `pack_state` sums (the same sign of a zero sum).
         tangent_sum.0[l] = ts[..count].iter().sum();
         out.stick.0[l] = if row_stick { u32::MAX } else { 0 };
-        out.tangent_share[0].0[l] = match count {
+        hd.tangent_share[0].0[l] = match count {
             2 => 0.5,
             1 => 1.0,
             _ => 0.0,
         };
-        out.tangent_share[1].0[l] = if count == 2 { 0.5 } else { 0.0 };
+        hd.tangent_share[1].0[l] = if count == 2 { 0.5 } else { 0.0 };
     }
-    out.tangent_impulse = tangent_sum;
+    hd.tangent_impulse = tangent_sum;
     // Four lanes at once (contact_solver::build_constraint and pack).
-    let n = out.normal;
+    let n = hd.normal;
     let t = V4 { x: n.y, y: -n.x };
-    let (ma, ia, mb, ib) = (out.inv_mass_a, out.inv_i_a, out.inv_mass_b, out.inv_i_b);
+    let (ma, ia, mb, ib) = (hd.inv_mass_a, hd.inv_i_a, hd.inv_mass_b, hd.inv_i_b);
     // k = m_a⁻¹ + m_b⁻¹ + I_a⁻¹ (r_a × d)² + I_b⁻¹ (r_b × d)² (effective_mass_inv).
     let k_of = |r_a: V4, r_b: V4, d: V4| {
         let (ra, rb) = (r_a.cross(d), r_b.cross(d));
@@ -490,7 +509,7 @@ pub(crate) fn build_group<S: StateRead>(
     };
     let inv_or_zero = |k: F4| k.gt(zero).select(one / k, zero);
     let sum = ma + mb;
-    out.split = sum.gt(zero).select(mb / sum, half);
+    hd.split = sum.gt(zero).select(mb / sum, half);
     let k_roll = ia + ib;
     out.rolling_mass = inv_or_zero(k_roll);
     let mut arms = [(V4::default(), V4::default()); 2];
@@ -503,9 +522,9 @@ pub(crate) fn build_group<S: StateRead>(
         let (r_a, r_b) = (keep(point[i] - center_a), keep(point[i] - center_b));
         arms[i] = (r_a, r_b);
         kn[i] = k_of(r_a, r_b, n);
+        hd.points[i].r_a = r_a;
+        hd.points[i].r_b = r_b;
         let wp = &mut out.points[i];
-        wp.r_a = r_a;
-        wp.r_b = r_b;
         wp.normal_mass = has[i].select(inv_or_zero(kn[i]), zero);
     }
     let ((ra0, rb0), (ra1, rb1)) = (arms[0], arms[1]);
@@ -556,34 +575,35 @@ pub(crate) struct StoredContact {
 /// and anchor displacement four lanes at a time, the sums and the stick/slip transitions
 /// lane by lane), written to `out` for the contacts to copy in contact order.
 pub(crate) fn store_group<S: StateRead>(
+    h: &WideHead,
     w: &WideContact,
     cold: &WideCold,
     states: &[S],
     ctx: &StepContext,
     out: &mut [StoredContact; LANES],
 ) {
-    let a = gather(states, &w.index_a);
-    let b = gather(states, &w.index_b);
+    let a = gather(states, &h.index_a);
+    let b = gather(states, &h.index_b);
     let d = b.dp - a.dp;
-    let n = w.normal;
+    let n = h.normal;
     let t = V4 { x: n.y, y: -n.x };
     let mut vt = [F4::ZERO; 2];
     let mut disp = [F4::ZERO; 2];
     for i in 0..2 {
-        let p = &w.points[i];
-        let (r_a, r_b) = lever_arms(w, d, p.r_a, p.r_b);
+        let p = &h.points[i];
+        let (r_a, r_b) = lever_arms(h, d, p.r_a, p.r_b);
         vt[i] = relative_velocity(&a, &b, r_a, r_b).dot(t) - w.tangent_speed;
         disp[i] = anchor_displacement(&a, &b, d, p.r_a, p.r_b).dot(t);
     }
     for (l, o) in out.iter_mut().enumerate() {
         let count = (cold.count[l] as usize).min(2);
         o.count = count as u8;
-        o.rolling_impulse = w.rolling_impulse.0[l];
+        o.rolling_impulse = h.rolling_impulse.0[l];
         let share = if count == 2 { 0.5 } else { 1.0 };
         let saturated = w.saturated.lane(l);
-        let (tangent, total_tangent) = (share * w.tangent_impulse.0[l], share * w.total_tangent_impulse.0[l]);
+        let (tangent, total_tangent) = (share * h.tangent_impulse.0[l], share * w.total_tangent_impulse.0[l]);
         let (mut sum_t, mut sum_n) = (0.0f32, 0.0f32);
-        for p in &w.points[..count] {
+        for p in &h.points[..count] {
             sum_t += tangent;
             sum_n += p.normal_impulse.0[l];
         }
@@ -594,7 +614,7 @@ pub(crate) fn store_group<S: StateRead>(
         for i in 0..count {
             let wp = &w.points[i];
             let (normal, total_normal, max) = (
-                wp.normal_impulse.0[l],
+                h.points[i].normal_impulse.0[l],
                 wp.total_normal_impulse.0[l],
                 wp.max_normal_impulse.0[l],
             );
@@ -646,6 +666,7 @@ pub(crate) fn store_group<S: StateRead>(
 
 /// Copies a scalar constraint into lane `l` (everything: geometry, masses, state).
 pub(crate) fn pack(
+    h: &mut WideHead,
     w: &mut WideContact,
     cold: &mut WideCold,
     l: usize,
@@ -666,35 +687,35 @@ pub(crate) fn pack(
         cold.stick[i][l] = real && cc.points[i].stick;
         cold.fresh[i][l] = real && cc.points[i].fresh;
     }
-    w.index_a[l] = cc.index_a;
-    w.index_b[l] = cc.index_b;
-    w.write_a[l] = dynamic_a && cc.index_a != 0;
-    w.write_b[l] = dynamic_b && cc.index_b != 0;
-    w.normal.x.0[l] = cc.normal.x;
-    w.normal.y.0[l] = cc.normal.y;
-    w.inv_mass_a.0[l] = cc.inv_mass_a;
-    w.inv_i_a.0[l] = cc.inv_i_a;
-    w.inv_mass_b.0[l] = cc.inv_mass_b;
-    w.inv_i_b.0[l] = cc.inv_i_b;
-    w.split.0[l] = cc.split;
+    h.index_a[l] = cc.index_a;
+    h.index_b[l] = cc.index_b;
+    h.write_a[l] = dynamic_a && cc.index_a != 0;
+    h.write_b[l] = dynamic_b && cc.index_b != 0;
+    h.normal.x.0[l] = cc.normal.x;
+    h.normal.y.0[l] = cc.normal.y;
+    h.inv_mass_a.0[l] = cc.inv_mass_a;
+    h.inv_i_a.0[l] = cc.inv_i_a;
+    h.inv_mass_b.0[l] = cc.inv_mass_b;
+    h.inv_i_b.0[l] = cc.inv_i_b;
+    h.split.0[l] = cc.split;
     w.mu_s.0[l] = cc.mu_s;
     w.mu_d.0[l] = cc.mu_d;
     w.tangent_speed.0[l] = cc.tangent_speed;
     w.rolling_resistance.0[l] = cc.rolling_resistance;
     w.rolling_mass.0[l] = cc.rolling_mass;
-    w.any_rolling |= cc.rolling_resistance > 0.0 || cc.rolling_impulse != 0.0;
+    h.any_rolling |= cc.rolling_resistance > 0.0 || cc.rolling_impulse != 0.0;
     let soft = cc.points[0].soft;
     w.bias_rate.0[l] = soft.bias_rate;
     w.mass_scale.0[l] = soft.mass_scale;
     w.impulse_scale.0[l] = soft.impulse_scale;
     for i in 0..2 {
-        let wp = &mut w.points[i];
+        let (hp, wp) = (&mut h.points[i], &mut w.points[i]);
         if i < cc.count {
             let cp = &cc.points[i];
-            wp.r_a.x.0[l] = cp.r_a.x;
-            wp.r_a.y.0[l] = cp.r_a.y;
-            wp.r_b.x.0[l] = cp.r_b.x;
-            wp.r_b.y.0[l] = cp.r_b.y;
+            hp.r_a.x.0[l] = cp.r_a.x;
+            hp.r_a.y.0[l] = cp.r_a.y;
+            hp.r_b.x.0[l] = cp.r_b.x;
+            hp.r_b.y.0[l] = cp.r_b.y;
             wp.base_separation.0[l] = cp.base_separation;
             wp.normal_mass.0[l] = cp.normal_mass;
             wp.preload.0[l] = cp.preload;
@@ -702,10 +723,10 @@ pub(crate) fn pack(
             // A point that does nothing: no mass, no anchors, no impulse (every product
             // with its zero mass stays finite and zero).
             for f in [
-                &mut wp.r_a.x,
-                &mut wp.r_a.y,
-                &mut wp.r_b.x,
-                &mut wp.r_b.y,
+                &mut hp.r_a.x,
+                &mut hp.r_a.y,
+                &mut hp.r_b.x,
+                &mut hp.r_b.y,
                 &mut wp.normal_mass,
                 &mut wp.preload,
                 &mut wp.base_separation,
@@ -746,13 +767,13 @@ pub(crate) fn pack(
     w.tangent_mass.0[l] = tm;
     w.base_drift.0[l] = drift;
     w.stick.0[l] = if stick { u32::MAX } else { 0 };
-    w.tangent_share[0].0[l] = share[0];
-    w.tangent_share[1].0[l] = share[1];
-    pack_state(w, l, cc);
+    h.tangent_share[0].0[l] = share[0];
+    h.tangent_share[1].0[l] = share[1];
+    pack_state(h, w, l, cc);
 }
 
 /// Copies the parts of a constraint that change during the substeps into lane `l`.
-pub(crate) fn pack_state(w: &mut WideContact, l: usize, cc: &ContactConstraint) {
+pub(crate) fn pack_state(h: &mut WideHead, w: &mut WideContact, l: usize, cc: &ContactConstraint) {
     for i in 0..2 {
         let wp = &mut w.points[i];
         let (lam, total, max, approach, vn) = if i < cc.count {
@@ -767,43 +788,43 @@ pub(crate) fn pack_state(w: &mut WideContact, l: usize, cc: &ContactConstraint) 
         } else {
             (0.0, 0.0, 0.0, 0.0, 0.0)
         };
-        wp.normal_impulse.0[l] = lam;
+        h.points[i].normal_impulse.0[l] = lam;
         wp.total_normal_impulse.0[l] = total;
         wp.max_normal_impulse.0[l] = max;
         wp.approach.0[l] = approach;
-        wp.substep_vn.0[l] = vn;
+        h.points[i].substep_vn.0[l] = vn;
     }
     let n = cc.count.min(2);
     let sum_t: f32 = cc.points[..n].iter().map(|p| p.tangent_impulse).sum();
     let sum_total_t: f32 = cc.points[..n].iter().map(|p| p.total_tangent_impulse).sum();
-    w.tangent_impulse.0[l] = sum_t;
+    h.tangent_impulse.0[l] = sum_t;
     w.total_tangent_impulse.0[l] = sum_total_t;
     w.saturated.0[l] = if cc.points[0].saturated { u32::MAX } else { 0 };
-    w.rolling_impulse.0[l] = cc.rolling_impulse;
+    h.rolling_impulse.0[l] = cc.rolling_impulse;
 }
 
 /// Copies lane `l`'s changing parts back into the scalar constraint.
-pub(crate) fn unpack_state(w: &WideContact, l: usize, cc: &mut ContactConstraint) {
+pub(crate) fn unpack_state(h: &WideHead, w: &WideContact, l: usize, cc: &mut ContactConstraint) {
     let count = cc.count.min(2);
     let share = if count == 2 { 0.5 } else { 1.0 };
     let saturated = w.saturated.lane(l);
     for i in 0..count {
         let wp = &w.points[i];
         let cp = &mut cc.points[i];
-        cp.normal_impulse = wp.normal_impulse.0[l];
+        cp.normal_impulse = h.points[i].normal_impulse.0[l];
         cp.total_normal_impulse = wp.total_normal_impulse.0[l];
         cp.max_normal_impulse = wp.max_normal_impulse.0[l];
         cp.approach = wp.approach.0[l];
-        cp.substep_vn = wp.substep_vn.0[l];
-        cp.tangent_impulse = share * w.tangent_impulse.0[l];
+        cp.substep_vn = h.points[i].substep_vn.0[l];
+        cp.tangent_impulse = share * h.tangent_impulse.0[l];
         cp.total_tangent_impulse = share * w.total_tangent_impulse.0[l];
         cp.saturated = saturated;
     }
-    cc.rolling_impulse = w.rolling_impulse.0[l];
+    cc.rolling_impulse = h.rolling_impulse.0[l];
 }
 
 /// Rebuilds the scalar constraint of lane `l` (geometry, masses and current state).
-pub(crate) fn unpack_full(w: &WideContact, cold: &WideCold, l: usize) -> ContactConstraint {
+pub(crate) fn unpack_full(h: &WideHead, w: &WideContact, cold: &WideCold, l: usize) -> ContactConstraint {
     let count = cold.count[l] as usize;
     let block = w.block.lane(l);
     let soft = Softness {
@@ -812,14 +833,14 @@ pub(crate) fn unpack_full(w: &WideContact, cold: &WideCold, l: usize) -> Contact
         impulse_scale: w.impulse_scale.0[l],
     };
     let mut cc = ContactConstraint {
-        index_a: w.index_a[l],
-        index_b: w.index_b[l],
+        index_a: h.index_a[l],
+        index_b: h.index_b[l],
         contact: cold.contact[l],
-        normal: Vec2::new(w.normal.x.0[l], w.normal.y.0[l]),
-        inv_mass_a: w.inv_mass_a.0[l],
-        inv_i_a: w.inv_i_a.0[l],
-        inv_mass_b: w.inv_mass_b.0[l],
-        inv_i_b: w.inv_i_b.0[l],
+        normal: Vec2::new(h.normal.x.0[l], h.normal.y.0[l]),
+        inv_mass_a: h.inv_mass_a.0[l],
+        inv_i_a: h.inv_i_a.0[l],
+        inv_mass_b: h.inv_mass_b.0[l],
+        inv_i_b: h.inv_i_b.0[l],
         mu_s: w.mu_s.0[l],
         mu_d: w.mu_d.0[l],
         restitution: cold.restitution[l],
@@ -839,7 +860,7 @@ pub(crate) fn unpack_full(w: &WideContact, cold: &WideCold, l: usize) -> Contact
             [0.0; 3]
         },
         block,
-        split: w.split.0[l],
+        split: h.split.0[l],
         kinetic_energy: cold.kinetic_energy[l],
         height: cold.height[l],
         patch_tangent_mass: if count == 2 { w.tangent_mass.0[l] } else { 0.0 },
@@ -849,8 +870,9 @@ pub(crate) fn unpack_full(w: &WideContact, cold: &WideCold, l: usize) -> Contact
     for i in 0..count {
         let wp = &w.points[i];
         let cp = &mut cc.points[i];
-        cp.r_a = Vec2::new(wp.r_a.x.0[l], wp.r_a.y.0[l]);
-        cp.r_b = Vec2::new(wp.r_b.x.0[l], wp.r_b.y.0[l]);
+        let hp = &h.points[i];
+        cp.r_a = Vec2::new(hp.r_a.x.0[l], hp.r_a.y.0[l]);
+        cp.r_b = Vec2::new(hp.r_b.x.0[l], hp.r_b.y.0[l]);
         cp.base_separation = wp.base_separation.0[l];
         cp.base_drift = cold.base_drift[i][l];
         cp.normal_mass = wp.normal_mass.0[l];
@@ -860,7 +882,7 @@ pub(crate) fn unpack_full(w: &WideContact, cold: &WideCold, l: usize) -> Contact
         cp.stick = cold.stick[i][l];
         cp.fresh = cold.fresh[i][l];
     }
-    unpack_state(w, l, &mut cc);
+    unpack_state(h, w, l, &mut cc);
     cc
 }
 
@@ -985,13 +1007,14 @@ mod tests {
     fn wide_build_equals_scalar_build_and_pack() {
         let f = fixture();
         let (ctx, soft, states, up, cases) = (f.ctx, f.soft, &f.states, f.up, &f.cases);
-        let (mut w, mut cold) = (WideContact::default(), WideCold::default());
-        build_group(&mut w, &mut cold, f.lanes(), up, &soft, &ctx, states);
-        let (mut r, mut rcold) = (w, cold);
+        let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
+        build_group(&mut h, &mut w, &mut cold, f.lanes(), up, &soft, &ctx, states);
+        let (mut rh, mut r, mut rcold) = (h, w, cold);
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
             let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
             let dyn_side = |m: f32, i: f32| m > 0.0 || i > 0.0;
             pack(
+                &mut rh,
                 &mut r,
                 &mut rcold,
                 l,
@@ -1000,17 +1023,17 @@ mod tests {
                 dyn_side(b.inv_mass_b, b.inv_i_b),
             );
         }
+        assert_eq!(format!("{h:?}"), format!("{rh:?}"));
         assert_eq!(format!("{w:?}"), format!("{r:?}"));
         assert_eq!(format!("{cold:?}"), format!("{rcold:?}"));
         // The cases do what they claim: a carried point sticks, a new one in contact and
-        // slipping slides; the empty
-        // lane carries no mass.
+        // slipping slides; the empty lane carries no mass.
         assert!(cold.stick[0][0] && !cold.stick[0][1] && cold.fresh[0][1]);
         assert_eq!(
-            (w.inv_mass_a.0[3], w.inv_mass_b.0[3], w.points[0].normal_mass.0[3]),
+            (h.inv_mass_a.0[3], h.inv_mass_b.0[3], w.points[0].normal_mass.0[3]),
             (0.0, 0.0, 0.0)
         );
-        assert!(w.any_rolling && cold.any_restitution && w.block.lane(0));
+        assert!(h.any_rolling && cold.any_restitution && w.block.lane(0));
     }
 
     /// The store's wide half must write into each contact exactly what the scalar store
@@ -1021,10 +1044,10 @@ mod tests {
     #[test]
     fn wide_store_equals_scalar_store() {
         let f = fixture();
-        let (mut w, mut cold) = (WideContact::default(), WideCold::default());
-        build_group(&mut w, &mut cold, f.lanes(), f.up, &f.soft, &f.ctx, &f.states);
+        let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
+        build_group(&mut h, &mut w, &mut cold, f.lanes(), f.up, &f.soft, &f.ctx, &f.states);
         let cells: Vec<core::cell::Cell<BodyState>> = f.states.iter().map(|&s| core::cell::Cell::new(s)).collect();
-        solve::<false, _>(&mut w, &cells, &f.ctx, f.ctx.h);
+        solve::<false, _>(&mut h, &mut w, &cells, &f.ctx, f.ctx.h);
         let moved: Vec<BodyState> = cells
             .iter()
             .map(|c| {
@@ -1035,10 +1058,10 @@ mod tests {
             })
             .collect();
         let mut out = [StoredContact::default(); LANES];
-        store_group(&w, &cold, &moved, &f.ctx, &mut out);
+        store_group(&h, &w, &cold, &moved, &f.ctx, &mut out);
         let (mut slipped, mut pushed) = (false, false);
         for l in 0..3 {
-            let cc = unpack_full(&w, &cold, l);
+            let cc = unpack_full(&h, &w, &cold, l);
             let mut c = crate::collision::contact::blank_contact();
             store_impulses(&cc, &mut c, &moved, &f.ctx);
             let n = cc.count;

@@ -97,6 +97,14 @@ pub(crate) trait StateCell: StateRead + Clone + Send {
         min_len: usize,
         f: impl Fn(usize, &mut T, &[Self]) + Sync + Send,
     );
+    /// [`StateCell::for_each_mut`] over two slices of the same length.
+    fn for_each_mut2<T: Send, U: Send>(
+        states: &[Self],
+        a: &mut [T],
+        b: &mut [U],
+        min_len: usize,
+        f: impl Fn(usize, &mut T, &mut U, &[Self]) + Sync + Send,
+    );
     /// Calls `f(i, states)` for `i` in `0..n` (split between threads for shared states).
     fn for_each_index(states: &[Self], n: usize, min_len: usize, f: impl Fn(usize, &[Self]) + Sync + Send);
     /// The states as shared states, when they are (the worker-team path).
@@ -124,6 +132,17 @@ impl StateCell for core::cell::Cell<BodyState> {
     ) {
         for (i, x) in items.iter_mut().enumerate() {
             f(i, x, states);
+        }
+    }
+    fn for_each_mut2<T: Send, U: Send>(
+        states: &[Self],
+        a: &mut [T],
+        b: &mut [U],
+        _min_len: usize,
+        f: impl Fn(usize, &mut T, &mut U, &[Self]) + Sync + Send,
+    ) {
+        for (i, (x, y)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
+            f(i, x, y, states);
         }
     }
     fn for_each_index(states: &[Self], n: usize, _min_len: usize, f: impl Fn(usize, &[Self]) + Sync + Send) {
@@ -157,6 +176,20 @@ impl StateCell for SharedState {
             .enumerate()
             .with_min_len(min_len)
             .for_each(|(i, x)| f(i, x, states));
+    }
+    fn for_each_mut2<T: Send, U: Send>(
+        states: &[Self],
+        a: &mut [T],
+        b: &mut [U],
+        min_len: usize,
+        f: impl Fn(usize, &mut T, &mut U, &[Self]) + Sync + Send,
+    ) {
+        use rayon::prelude::*;
+        a.par_iter_mut()
+            .zip(b.par_iter_mut())
+            .enumerate()
+            .with_min_len(min_len)
+            .for_each(|(i, (x, y))| f(i, x, y, states));
     }
     fn for_each_index(states: &[Self], n: usize, min_len: usize, f: impl Fn(usize, &[Self]) + Sync + Send) {
         use rayon::prelude::*;
@@ -324,24 +357,27 @@ pub(crate) fn for_each_mut<T: Send>(parallel: bool, items: &mut [T], min_len: us
     }
 }
 
-/// Like [`for_each_mut`] over two slices of the same length, item by item.
-pub(crate) fn for_each_mut2<A: Send, B: Send>(
+/// Calls `f(i, &mut a[i], &mut b[i], &mut c[i])` for every index, split between the pool's
+/// threads when `parallel` (see [`for_each_mut`]).
+pub(crate) fn for_each_mut3<A: Send, B: Send, C: Send>(
     parallel: bool,
     a: &mut [A],
     b: &mut [B],
+    c: &mut [C],
     min_len: usize,
-    f: impl Fn(usize, &mut A, &mut B) + Sync,
+    f: impl Fn(usize, &mut A, &mut B, &mut C) + Sync,
 ) {
     if parallel {
         use rayon::prelude::*;
         a.par_iter_mut()
             .zip(b.par_iter_mut())
+            .zip(c.par_iter_mut())
             .enumerate()
             .with_min_len(min_len)
-            .for_each(|(i, (x, y))| f(i, x, y));
+            .for_each(|(i, ((x, y), z))| f(i, x, y, z));
     } else {
-        for (i, (x, y)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
-            f(i, x, y);
+        for (i, ((x, y), z)) in a.iter_mut().zip(b.iter_mut()).zip(c.iter_mut()).enumerate() {
+            f(i, x, y, z);
         }
     }
 }
