@@ -6,15 +6,20 @@
 //!    the lowest free colour, pairs with a static or kinematic side the highest, so each
 //!    pass solves them last, as Box2D v3's `constraint_graph.c` does); no free colour →
 //!    overflow;
-//! 2. lay the colours out as runs of [`WideContact`]s (four lanes each);
-//! 3. build each scalar constraint ([`build_constraint`]) and pack it into its lane, or keep
-//!    it whole in the overflow list.
+//! 2. lay the colours out as runs of groups of four lanes ([`WideHead`] + [`WideContact`]
+//!    + [`WideCold`]); inside a colour, face contacts whose two points both carried load
+//!    go first (they will most likely take the 2×2 block's fast path together);
+//! 3. build the groups four lanes at a time ([`contact_wide::build_group`]), or keep a
+//!    constraint whole in the overflow list ([`build_constraint`]).
+//!
+//! Store (after the substeps): each group computes what its lanes write into their
+//! contacts ([`contact_wide::store_group`]), then the solved contacts copy it in contact
+//! order.
 //!
 //! The physics of a lane and of a scalar constraint are the same ([`contact_wide`] docs);
 //! the scalar code still runs wherever it is simpler: overflow, the warm-start estimate of
-//! new contacts, the extra sweeps of light bodies under heavy ones, restitution, and
-//! storing impulses back into the contacts (each rebuilds what it needs of a lane with
-//! [`contact_wide::unpack_full`] or [`contact_wide::unpack_for_store`] and writes the
+//! new contacts, the extra sweeps of light bodies under heavy ones and restitution (each
+//! rebuilds what it needs of a lane with [`contact_wide::unpack_full`] and writes the
 //! lane's state back).
 //!
 //! With several threads, the substeps run as one job on every thread ([`team_loop`]):
