@@ -299,6 +299,27 @@ impl ContactSolver {
         if self.loaded {
             self.build_groups(light, candidates);
         }
+        #[cfg(debug_assertions)]
+        self.check_colours(states.len());
+    }
+
+    /// Debug builds: no moving body appears twice in one colour (the threads' shared
+    /// states rely on it, see [`SharedState`]).
+    #[cfg(debug_assertions)]
+    fn check_colours(&self, bodies: usize) {
+        let mut seen = vec![u32::MAX; bodies];
+        for (k, &(start, end)) in self.ranges.iter().enumerate() {
+            for h in &self.head[start as usize..end as usize] {
+                for l in 0..LANES {
+                    for (write, index) in [(h.write_a[l], h.index_a[l]), (h.write_b[l], h.index_b[l])] {
+                        if write {
+                            assert_ne!(seen[index as usize], k as u32, "body {index} twice in colour {k}");
+                            seen[index as usize] = k as u32;
+                        }
+                    }
+                }
+            }
+        }
     }
 
     /// Mass-ratio groups: each light body touching a moving body more than
