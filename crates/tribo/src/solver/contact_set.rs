@@ -107,6 +107,7 @@ pub(crate) struct ContactSolver {
     /// What each lane stores into its contact (the store's first half, in group order).
     stored: Vec<[StoredContact; LANES]>,
     // Scratch reused every step.
+    /// Each candidate's colour (with the [`FAST`] flag) or [`OVERFLOW`].
     colours: Vec<u8>,
     used: Vec<u32>,
     slots: Vec<Slot>,
@@ -120,6 +121,10 @@ const CONTACT_STORE_CHUNK: usize = 512;
 
 /// No colour: the constraint goes to the overflow list.
 const OVERFLOW: u8 = u8::MAX;
+
+/// Flag in a constraint's colour byte: it goes to the front of its colour ([`fast_first`]).
+const FAST: u8 = 0x40;
+const _: () = assert!(COLORS <= FAST as usize);
 
 /// The colours' runs of `wide` as separate mutable slices (`ranges` ascending, disjoint).
 fn split_ranges<'a, T>(wide: &'a mut [T], ranges: &[(u32, u32)]) -> Vec<&'a mut [T]> {
@@ -175,8 +180,19 @@ impl ContactSolver {
         let mut counts = [0u32; COLORS];
         // Constraints likely to take the solver's fast path, per colour (see `fast_first`).
         let mut fast_counts = [0u32; COLORS];
+        let mut light: Vec<(u32, u32)> = Vec::new(); // (light body state, sweeps)
         for cand in candidates {
             let b = &cand.bodies;
+            if b.inv_mass_a > 0.0 && b.inv_mass_b > 0.0 {
+                let (ratio, body) = if b.inv_mass_a > b.inv_mass_b {
+                    (b.inv_mass_a / b.inv_mass_b, b.index_a)
+                } else {
+                    (b.inv_mass_b / b.inv_mass_a, b.index_b)
+                };
+                if ratio > MASS_RATIO_GROUP {
+                    light.push((body, (ratio.ceil() as u32).min(MAX_LOCAL_SWEEPS)));
+                }
+            }
             let (da, db) = (
                 b.index_a != 0 && dynamic_side(b.inv_mass_a, b.inv_i_a),
                 b.index_b != 0 && dynamic_side(b.inv_mass_b, b.inv_i_b),
@@ -198,8 +214,9 @@ impl ContactSolver {
                         self.used[b.index_b as usize] |= 1 << k;
                     }
                     counts[k] += 1;
-                    fast_counts[k] += fast_first(&cand.input) as u32;
-                    self.colours.push(k as u8);
+                    let fast = fast_first(&cand.input);
+                    fast_counts[k] += fast as u32;
+                    self.colours.push(k as u8 | if fast { FAST } else { 0 });
                 }
                 None => self.colours.push(OVERFLOW),
             }
@@ -230,20 +247,11 @@ impl ContactSolver {
         self.slots.clear();
         self.lane_candidates.clear();
         self.lane_candidates.resize(groups as usize, [u32::MAX; LANES]);
-        let mut light: Vec<(u32, u32)> = Vec::new(); // (light body state, sweeps)
-        for (i, (cand, &colour)) in candidates.iter().zip(&self.colours).enumerate() {
-            let b = &cand.bodies;
-            if b.inv_mass_a > 0.0 && b.inv_mass_b > 0.0 {
-                let (ratio, body) = if b.inv_mass_a > b.inv_mass_b {
-                    (b.inv_mass_a / b.inv_mass_b, b.index_a)
-                } else {
-                    (b.inv_mass_b / b.inv_mass_a, b.index_b)
-                };
-                if ratio > MASS_RATIO_GROUP {
-                    light.push((body, (ratio.ceil() as u32).min(MAX_LOCAL_SWEEPS)));
-                }
-            }
+        // Reads only the colour bytes (and the rare overflow candidates), not the candidates.
+        for (i, &colour) in self.colours.iter().enumerate() {
             let slot = if colour == OVERFLOW {
+                let Some(cand) = candidates.get(i) else { continue };
+                let b = &cand.bodies;
                 let cc = build_constraint(cand.contact, &cand.input, b, self.up, &soft, ctx, states);
                 if has_fresh_point(&cc) {
                     self.fresh.push(Slot::Overflow(self.overflow.len() as u32));
@@ -251,10 +259,11 @@ impl ContactSolver {
                 self.overflow.push(cc);
                 Slot::Overflow(self.overflow.len() as u32 - 1)
             } else {
-                let next = if fast_first(&cand.input) {
-                    &mut next[colour as usize]
+                let k = (colour & !FAST) as usize;
+                let next = if colour & FAST != 0 {
+                    &mut next[k]
                 } else {
-                    &mut next_slow[colour as usize]
+                    &mut next_slow[k]
                 };
                 let at = *next;
                 *next += 1;

@@ -199,29 +199,47 @@ impl World {
     fn collide(&mut self, dt: f32, parallel: bool) {
         let mut active = core::mem::take(&mut self.active_contacts);
         let mut flags = core::mem::take(&mut self.scratch_flags);
-        self.collect_active_contacts(&mut active, &mut flags, false);
-        self.scratch_flags = flags;
-        let mut mark = core::mem::take(&mut self.scratch_mark);
-        mark.clear();
-        mark.resize(self.contacts.len(), false);
-        for &ci in &active {
-            mark[ci as usize] = true;
-        }
         let (bodies, shapes) = (&self.bodies, &self.shapes);
-        for_each_mut(parallel, &mut self.contacts, CONTACT_CHUNK, |ci, slot| {
-            // The mark first: a sleeping contact's record is not even read.
-            if mark[ci] {
+        if self.active_body_flags(&mut flags) {
+            // Mostly awake: each contact tests its two bodies' flags itself, in the parallel
+            // pass (no serial pass to list the active contacts first); then every contact
+            // is visited in order below.
+            active.clear();
+            active.extend(0..self.contacts.len() as u32);
+            let flags = &flags;
+            let flag = |bi: u32| flags.get(bi as usize).copied().unwrap_or(false);
+            for_each_mut(parallel, &mut self.contacts, CONTACT_CHUNK, |_, slot| {
                 if let Some(c) = slot.as_mut() {
-                    c.outcome = narrow_phase(c, bodies, shapes, dt);
+                    if flag(c.body_a) || flag(c.body_b) {
+                        c.outcome = narrow_phase(c, bodies, shapes, dt);
+                    }
                 }
+            });
+        } else {
+            self.collect_active_contacts(&mut active, &flags, false, false);
+            let mut mark = core::mem::take(&mut self.scratch_mark);
+            mark.clear();
+            mark.resize(self.contacts.len(), false);
+            for &ci in &active {
+                mark[ci as usize] = true;
             }
-        });
-        self.scratch_mark = mark;
+            for_each_mut(parallel, &mut self.contacts, CONTACT_CHUNK, |ci, slot| {
+                // The mark first: a sleeping contact's record is not even read.
+                if mark[ci] {
+                    if let Some(c) = slot.as_mut() {
+                        c.outcome = narrow_phase(c, bodies, shapes, dt);
+                    }
+                }
+            });
+            self.scratch_mark = mark;
+        }
+        self.scratch_flags = flags;
         let mut to_destroy = Vec::new();
         let mut to_wake = Vec::new();
         let mut touching = core::mem::take(&mut self.touching_contacts);
         touching.clear();
         for &ci in &active {
+            // Contacts not updated this step read `Skipped` (the outcome is taken below).
             let Some(c) = self.contacts[ci as usize].as_mut() else {
                 continue;
             };
@@ -266,20 +284,18 @@ impl World {
             // The woken islands' contacts join the solve with their last manifolds.
             let mut touching = core::mem::take(&mut self.touching_contacts);
             let mut flags = core::mem::take(&mut self.scratch_flags);
-            self.collect_active_contacts(&mut touching, &mut flags, true);
+            let mostly_awake = self.active_body_flags(&mut flags);
+            self.collect_active_contacts(&mut touching, &flags, mostly_awake, true);
             self.scratch_flags = flags;
             self.touching_contacts = touching;
         }
     }
 
-    /// The contacts with an awake moving body (only touching ones if `touching_only`), in
-    /// contact order: found through the awake bodies' contact lists, so sleeping islands
-    /// cost nothing.
-    /// `flags` is scratch (one flag per body slot).
-    fn collect_active_contacts(&self, out: &mut Vec<u32>, flags: &mut Vec<bool>, touching_only: bool) {
-        out.clear();
-        // One flag per body slot, read in body order (the contacts then test two bytes
-        // instead of two body records).
+    /// One flag per body slot: awake and not static (read in body order, so the contacts
+    /// then test two bytes instead of two body records). Returns whether most bodies are
+    /// awake (then one pass over the contacts in memory order beats chasing the awake
+    /// bodies' contact lists).
+    fn active_body_flags(&self, flags: &mut Vec<bool>) -> bool {
         flags.clear();
         flags.resize(self.bodies.capacity(), false);
         let mut awake = 0usize;
@@ -289,8 +305,17 @@ impl World {
                 awake += 1;
             }
         }
+        2 * awake > self.bodies.len()
+    }
+
+    /// The contacts with an awake moving body (only touching ones if `touching_only`), in
+    /// contact order: found through the awake bodies' contact lists, so sleeping islands
+    /// cost nothing. `flags` and `mostly_awake`: [`World::active_body_flags`], just
+    /// computed.
+    fn collect_active_contacts(&self, out: &mut Vec<u32>, flags: &[bool], mostly_awake: bool, touching_only: bool) {
+        out.clear();
         let active = |bi: u32| flags.get(bi as usize).copied().unwrap_or(false);
-        if 2 * awake > self.bodies.len() {
+        if mostly_awake {
             // Mostly awake: one pass in memory order beats chasing the bodies' lists.
             for (ci, c) in self.contacts.iter().enumerate() {
                 let Some(c) = c else { continue };
