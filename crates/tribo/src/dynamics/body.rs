@@ -153,9 +153,9 @@ pub(crate) struct Body {
     pub awake: bool,
     /// How long [s] the body has been below its sleep threshold.
     pub sleep_time: f32,
-    /// Largest distance from the centre of mass to any of its shapes' points [m].
     /// Set by finalize when the solver produced a non-finite state (reported, then cleared).
     pub non_finite: bool,
+    /// Largest distance from the centre of mass to any of its shapes' points [m].
     pub max_extent: f32,
     pub shapes: Vec<ShapeId>,
     /// Indices of the contacts this body takes part in.

@@ -528,6 +528,13 @@ impl World {
         if !self.def.enable_sleep {
             return;
         }
+        // An island falls asleep when its least rested body has rested `time_to_sleep`: while
+        // no awake body has, no island can, and the islands need not be built (a pile that
+        // keeps moving, like the tumbler's, pays one pass over the bodies).
+        let tts = self.def.time_to_sleep;
+        if !self.bodies.iter().any(|(_, b)| b.awake && b.is_dynamic() && b.sleep_time >= tts) {
+            return;
+        }
         let n = self.bodies.capacity();
         let mut parent = core::mem::take(&mut self.scratch_u32);
         parent.clear();
@@ -572,7 +579,6 @@ impl World {
         }
         if any {
             let mut islands: Vec<(u32, Vec<u32>)> = Vec::new();
-            let tts = self.def.time_to_sleep;
             let mut members_of_root: std::collections::BTreeMap<u32, Vec<u32>> = Default::default();
             for (bi, b) in self.bodies.iter() {
                 if b.awake && b.is_dynamic() {
