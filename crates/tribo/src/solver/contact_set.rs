@@ -52,17 +52,34 @@ enum Slot {
 }
 
 /// One touching contact to solve this step.
+///
+/// `repr(C)`, 16-byte aligned, 160 bytes: what the colouring pass reads (contact, the
+/// fast-first flag, body indices and inverse masses) is the first 32 bytes, never split
+/// between two cache lines; the solver input follows.
 #[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
 pub(crate) struct Candidate {
     pub contact: u32,
+    /// [`fast_first`] of the input.
+    fast: bool,
     pub bodies: ConstraintBodies,
     pub input: ContactInput,
 }
 
 impl Candidate {
+    pub fn new(contact: u32, bodies: ConstraintBodies, input: ContactInput) -> Candidate {
+        Candidate {
+            contact,
+            fast: fast_first(&input),
+            bodies,
+            input,
+        }
+    }
+
     /// A placeholder for a contact that is not solved this step.
     pub const SKIP: Candidate = Candidate {
         contact: u32::MAX,
+        fast: false,
         bodies: ConstraintBodies {
             index_a: 0,
             index_b: 0,
@@ -106,6 +123,10 @@ pub(crate) struct ContactSolver {
     lane_candidates: Vec<[u32; LANES]>,
     /// What each lane stores into its contact (the store's first half, in group order).
     stored: Vec<[StoredContact; LANES]>,
+    /// The contact of each candidate (the store's second half reads these 4 bytes, not
+    /// the candidates' records), and whether they ascend.
+    contact_of: Vec<u32>,
+    contacts_ascend: bool,
     // Scratch reused every step.
     /// Each candidate's colour (with the [`FAST`] flag) or [`OVERFLOW`].
     colours: Vec<u8>,
@@ -181,7 +202,13 @@ impl ContactSolver {
         // Constraints likely to take the solver's fast path, per colour (see `fast_first`).
         let mut fast_counts = [0u32; COLORS];
         let mut light: Vec<(u32, u32)> = Vec::new(); // (light body state, sweeps)
+        self.contact_of.clear();
+        self.contacts_ascend = true;
         for cand in candidates {
+            if self.contact_of.last().is_some_and(|&last| last >= cand.contact) {
+                self.contacts_ascend = false;
+            }
+            self.contact_of.push(cand.contact);
             let b = &cand.bodies;
             if b.inv_mass_a > 0.0 && b.inv_mass_b > 0.0 {
                 let (ratio, body) = if b.inv_mass_a > b.inv_mass_b {
@@ -214,7 +241,7 @@ impl ContactSolver {
                         self.used[b.index_b as usize] |= 1 << k;
                     }
                     counts[k] += 1;
-                    let fast = fast_first(&cand.input);
+                    let fast = cand.fast;
                     fast_counts[k] += fast as u32;
                     self.colours.push(k as u8 | if fast { FAST } else { 0 });
                 }
@@ -393,16 +420,11 @@ impl ContactSolver {
     /// Writes every constraint's impulses and friction state back into its contact
     /// (`contacts` is the world's contact list), in two halves: the lanes compute what
     /// they store group by group (reading each group once, in memory order), then the
-    /// contacts copy it in contact order: `candidates` are sorted by contact, so only the
-    /// solved contacts are visited. With threads, both halves are split: by groups, then
-    /// by chunks of candidates whose contacts are disjoint ranges of the list.
-    pub fn store<S: StateRead + Sync>(
-        &mut self,
-        ctx: &StepContext,
-        states: &[S],
-        candidates: &[Candidate],
-        contacts: &mut [Option<Contact>],
-    ) {
+    /// contacts copy it in contact order: the candidates of [`ContactSolver::build`] are
+    /// sorted by contact, so only the solved contacts are visited. With threads, both halves
+    /// are split: by groups, then by chunks of candidates whose contacts are disjoint ranges
+    /// of the list.
+    pub fn store<S: StateRead + Sync>(&mut self, ctx: &StepContext, states: &[S], contacts: &mut [Option<Contact>]) {
         let (head, wide, cold) = (&self.head, &self.wide, &self.cold);
         self.stored.resize(wide.len(), [StoredContact::default(); LANES]);
         self.stored.truncate(wide.len());
@@ -410,9 +432,9 @@ impl ContactSolver {
             contact_wide::store_group(&head[g], &wide[g], &cold[g], states, ctx, out);
         });
         let this = &*self;
-        let store_run = |first: usize, cands: &[Candidate], base: usize, contacts: &mut [Option<Contact>]| {
-            for (k, cand) in cands.iter().enumerate() {
-                let Some(Some(c)) = contacts.get_mut((cand.contact as usize).wrapping_sub(base)) else {
+        let store_run = |first: usize, cands: &[u32], base: usize, contacts: &mut [Option<Contact>]| {
+            for (k, &contact) in cands.iter().enumerate() {
+                let Some(Some(c)) = contacts.get_mut((contact as usize).wrapping_sub(base)) else {
                     continue;
                 };
                 match this.slots.get(first + k) {
@@ -431,8 +453,8 @@ impl ContactSolver {
                 }
             }
         };
-        let ascending = candidates.windows(2).all(|p| p[0].contact < p[1].contact);
-        if !ctx.parallel || !ascending || candidates.len() <= CONTACT_STORE_CHUNK {
+        let candidates = &self.contact_of;
+        if !ctx.parallel || !self.contacts_ascend || candidates.len() <= CONTACT_STORE_CHUNK {
             store_run(0, candidates, 0, contacts);
             return;
         }
@@ -441,7 +463,7 @@ impl ContactSolver {
         let mut rest = contacts;
         let mut base = 0usize;
         for (k, chunk) in candidates.chunks(CONTACT_STORE_CHUNK).enumerate() {
-            let end = (chunk[chunk.len() - 1].contact as usize + 1).min(base + rest.len());
+            let end = (chunk[chunk.len() - 1] as usize + 1).min(base + rest.len());
             let (mine, tail) = rest.split_at_mut(end - base);
             runs.push((k * CONTACT_STORE_CHUNK, chunk, base, mine));
             rest = tail;

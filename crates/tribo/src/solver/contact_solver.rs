@@ -128,8 +128,10 @@ pub(crate) struct ContactConstraint {
     pub points: [ConstraintPoint; 2],
 }
 
-/// Everything the prepare stage needs about the two bodies of a contact.
+/// Everything the prepare stage needs about the two bodies of a contact (`repr(C)`: the
+/// indices and inverse masses first, what the colouring reads).
 #[derive(Clone, Copy, Debug)]
+#[repr(C)]
 pub(crate) struct ConstraintBodies {
     pub index_a: u32,
     pub index_b: u32,

@@ -408,10 +408,9 @@ impl World {
                 }
             };
             let ((inv_mass_a, inv_i_a), (inv_mass_b, inv_i_b)) = (side(ba), side(bb));
-            Some(Candidate {
-                contact: ci,
-                input: ContactInput::new(c),
-                bodies: ConstraintBodies {
+            Some(Candidate::new(
+                ci,
+                ConstraintBodies {
                     index_a: ba.solver_index,
                     index_b: bb.solver_index,
                     inv_mass_a,
@@ -421,7 +420,8 @@ impl World {
                     center_a: ba.center,
                     center_b: bb.center,
                 },
-            })
+                ContactInput::new(c),
+            ))
         };
         // No per-step allocation. Threads: written in place, the rare rejects dropped
         // after. One thread: pushed straight into the list (no temporary to copy).
@@ -455,7 +455,7 @@ impl World {
             solve_step(ctx, &self.sims, cells, &mut solver, &mut self.profile);
         }
         lap.lap();
-        solver.store(ctx, &self.states, &self.candidates, &mut self.contacts);
+        solver.store(ctx, &self.states, &mut self.contacts);
         self.contact_solver = solver;
         self.profile.store = lap.lap();
     }
@@ -532,7 +532,11 @@ impl World {
         // no awake body has, no island can, and the islands need not be built (a pile that
         // keeps moving, like the tumbler's, pays one pass over the bodies).
         let tts = self.def.time_to_sleep;
-        if !self.bodies.iter().any(|(_, b)| b.awake && b.is_dynamic() && b.sleep_time >= tts) {
+        if !self
+            .bodies
+            .iter()
+            .any(|(_, b)| b.awake && b.is_dynamic() && b.sleep_time >= tts)
+        {
             return;
         }
         let n = self.bodies.capacity();
