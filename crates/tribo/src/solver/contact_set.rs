@@ -137,6 +137,12 @@ pub(crate) struct ContactSolver {
 /// Wide constraints per parallel chunk of a colour.
 const GROUP_CHUNK: usize = 32;
 
+/// How many groups ahead the build asks for its candidates' cache lines.
+const PREFETCH_GROUPS: usize = 4;
+
+/// How many contacts ahead the store asks for the lane results it will copy.
+const PREFETCH_STORED: usize = 8;
+
 /// Contacts per parallel chunk of the impulse store.
 const CONTACT_STORE_CHUNK: usize = 512;
 
@@ -313,6 +319,13 @@ impl ContactSolver {
             &mut self.cold,
             GROUP_CHUNK,
             |g, h, w, cold| {
+                if let Some(ahead) = lane_candidates.get(g + PREFETCH_GROUPS) {
+                    for &i in ahead {
+                        if let Some(cand) = candidates.get(i as usize) {
+                            super::prefetch(cand);
+                        }
+                    }
+                }
                 let lanes = lane_candidates[g].map(|i| {
                     candidates
                         .get(i as usize)
@@ -434,6 +447,11 @@ impl ContactSolver {
         let this = &*self;
         let store_run = |first: usize, cands: &[u32], base: usize, contacts: &mut [Option<Contact>]| {
             for (k, &contact) in cands.iter().enumerate() {
+                if let Some(&Slot::Wide { group, lane }) = this.slots.get(first + k + PREFETCH_STORED) {
+                    if let Some(s) = this.stored.get(group as usize) {
+                        super::prefetch(&s[lane as usize]);
+                    }
+                }
                 let Some(Some(c)) = contacts.get_mut((contact as usize).wrapping_sub(base)) else {
                     continue;
                 };

@@ -432,7 +432,13 @@ impl World {
             candidates.retain(|c| c.contact != Candidate::SKIP.contact);
         } else {
             candidates.clear();
-            for &ci in &self.touching_contacts {
+            let touching = &self.touching_contacts;
+            for (k, &ci) in touching.iter().enumerate() {
+                // The bodies of a contact a few ahead (contacts come in order, bodies not).
+                if let Some(Some(Some(c))) = touching.get(k + PREFETCH_CONTACTS).map(|&a| contacts.get(a as usize)) {
+                    bodies.prefetch(c.body_a);
+                    bodies.prefetch(c.body_b);
+                }
                 if let Some(c) = candidate(ci) {
                     candidates.push(c);
                 }
@@ -612,6 +618,9 @@ const BODY_CHUNK: usize = 256;
 
 /// Contacts per parallel chunk of the narrow phase and the impulse store.
 const CONTACT_CHUNK: usize = 256;
+
+/// How many contacts ahead the solver's candidate pass asks for the bodies' records.
+const PREFETCH_CONTACTS: usize = 8;
 
 /// Contact lists up to this long are searched for an existing pair instead of the pair
 /// table (a few keys in one cache line beat a hash probe into a large table).
