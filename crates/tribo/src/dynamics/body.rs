@@ -164,8 +164,6 @@ pub(crate) struct Body {
     /// body's short list before the world's pair table.
     pub contact_keys: Vec<u64>,
     pub user_data: u64,
-    /// Index of the body's state in the solver arrays during a step (0 = none/static).
-    pub solver_index: u32,
     /// Sleeping island this body belongs to while asleep (index into the world's list).
     pub sleep_island: u32,
 }
@@ -204,7 +202,6 @@ impl Body {
             contacts: Vec::new(),
             contact_keys: Vec::new(),
             user_data: def.user_data,
-            solver_index: 0,
             sleep_island: u32::MAX,
         }
     }

@@ -338,6 +338,23 @@ pub(crate) struct BodySim {
     pub body: u32,
 }
 
+/// What the constraint build needs of a body, one per body slot (static and sleeping
+/// bodies too: their centre anchors the contacts), in a compact array filled at the start
+/// of the solve: the per-contact pass reads 24 bytes per body, not the body's record.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct SolverBody {
+    /// Index of the body's state in the solver arrays (0 = none: static or asleep).
+    pub index: u32,
+    /// Awake and dynamic: its contacts are solved this step.
+    pub awake_dynamic: bool,
+    /// Inverse mass [1/kg] and inverse rotational inertia [1/(kg·m²)] as the solver sees
+    /// them (0 for bodies without a state).
+    pub inv_mass: f32,
+    pub inv_i: f32,
+    /// World centre of mass [m].
+    pub center: Vec2,
+}
+
 /// Tunable numbers of the solver, fixed for one step.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct StepContext {

@@ -102,14 +102,6 @@ impl<T> Arena<T> {
         self.slots.get(index as usize).and_then(|s| s.value.as_ref())
     }
 
-    /// Asks for the cache lines of a slot ahead of use ([`crate::solver::prefetch`]).
-    #[inline]
-    pub fn prefetch(&self, index: u32) {
-        if let Some(slot) = self.slots.get(index as usize) {
-            crate::solver::prefetch(slot);
-        }
-    }
-
     /// The value at a slot index, whatever its generation (internal links).
     #[inline]
     pub fn at_mut(&mut self, index: u32) -> Option<&mut T> {

@@ -135,6 +135,8 @@ pub struct World {
     pub(crate) scratch_mark: Vec<bool>,
     /// Scratch: one flag per body slot (active bodies, see `collect_active_contacts`).
     pub(crate) scratch_flags: Vec<bool>,
+    /// Per body slot, what the solver's constraints need of it (rebuilt every step).
+    pub(crate) solver_bodies: Vec<crate::solver::SolverBody>,
     pub(crate) step_count: u64,
     pub(crate) profile: Profile,
     /// Worker threads when `def.workers > 1`.
@@ -179,6 +181,7 @@ impl World {
             scratch_f32: Vec::new(),
             scratch_mark: Vec::new(),
             scratch_flags: Vec::new(),
+            solver_bodies: Vec::new(),
             step_count: 0,
             profile: Profile::default(),
             pool: make_pool(def.workers)?,

@@ -17,7 +17,7 @@ use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::Candidate;
 use crate::solver::contact_solver::{ConstraintBodies, ContactInput};
-use crate::solver::{for_each_mut, map_into, solve_step, BodySim, BodyState, SharedState, StepContext};
+use crate::solver::{for_each_mut, map_into, solve_step, BodySim, BodyState, SharedState, SolverBody, StepContext};
 use crate::world::Arena;
 use crate::world::BodyId;
 
@@ -356,13 +356,23 @@ impl World {
         self.states.push(BodyState::default()); // index 0: every static body
         self.sims.push(BodySim::default());
         let capacity = self.bodies.capacity();
+        self.solver_bodies.clear();
+        self.solver_bodies.resize(capacity, SolverBody::default());
         for bi in 0..capacity as u32 {
-            let Some(b) = self.bodies.at_mut(bi) else { continue };
+            let (Some(b), Some(sb)) = (self.bodies.at(bi), self.solver_bodies.get_mut(bi as usize)) else {
+                continue;
+            };
+            sb.center = b.center;
             if !b.awake || b.body_type == BodyType::Static {
-                b.solver_index = 0;
                 continue;
             }
-            b.solver_index = self.states.len() as u32;
+            *sb = SolverBody {
+                index: self.states.len() as u32,
+                awake_dynamic: b.is_dynamic(),
+                inv_mass: b.inv_mass,
+                inv_i: b.inv_inertia,
+                center: b.center,
+            };
             self.states.push(BodyState {
                 v: b.v,
                 w: b.w,
@@ -388,35 +398,29 @@ impl World {
         // Constraints, in contact order (the colouring puts pairs with a static side in the
         // top colours, so each pass still solves them last, as Box2D's colouring does).
         let mut candidates = core::mem::take(&mut self.candidates);
-        let bodies = &self.bodies;
+        let solver_bodies = &self.solver_bodies;
         let contacts = &self.contacts;
         let candidate = |ci: u32| -> Option<Candidate> {
             let c = contacts.get(ci as usize)?.as_ref()?;
             if !c.touching {
                 return None;
             }
-            let (ba, bb) = (bodies.at(c.body_a)?, bodies.at(c.body_b)?);
-            let awake_dynamic = (ba.awake && ba.is_dynamic()) || (bb.awake && bb.is_dynamic());
-            if !awake_dynamic {
+            let (ba, bb) = (
+                solver_bodies.get(c.body_a as usize)?,
+                solver_bodies.get(c.body_b as usize)?,
+            );
+            if !ba.awake_dynamic && !bb.awake_dynamic {
                 return None;
             }
-            let side = |b: &Body| {
-                if b.solver_index == 0 {
-                    (0.0, 0.0)
-                } else {
-                    (b.inv_mass, b.inv_inertia)
-                }
-            };
-            let ((inv_mass_a, inv_i_a), (inv_mass_b, inv_i_b)) = (side(ba), side(bb));
             Some(Candidate::new(
                 ci,
                 ConstraintBodies {
-                    index_a: ba.solver_index,
-                    index_b: bb.solver_index,
-                    inv_mass_a,
-                    inv_i_a,
-                    inv_mass_b,
-                    inv_i_b,
+                    index_a: ba.index,
+                    index_b: bb.index,
+                    inv_mass_a: ba.inv_mass,
+                    inv_i_a: ba.inv_i,
+                    inv_mass_b: bb.inv_mass,
+                    inv_i_b: bb.inv_i,
                     center_a: ba.center,
                     center_b: bb.center,
                 },
@@ -436,8 +440,11 @@ impl World {
             for (k, &ci) in touching.iter().enumerate() {
                 // The bodies of a contact a few ahead (contacts come in order, bodies not).
                 if let Some(Some(Some(c))) = touching.get(k + PREFETCH_CONTACTS).map(|&a| contacts.get(a as usize)) {
-                    bodies.prefetch(c.body_a);
-                    bodies.prefetch(c.body_b);
+                    for bi in [c.body_a, c.body_b] {
+                        if let Some(sb) = solver_bodies.get(bi as usize) {
+                            crate::solver::prefetch(sb);
+                        }
+                    }
                 }
                 if let Some(c) = candidate(ci) {
                     candidates.push(c);
@@ -469,12 +476,13 @@ impl World {
     /// Writes the solver's motion back to the bodies, refreshes fat boxes and sleep timers.
     fn finalize(&mut self, dt: f32, parallel: bool) {
         // Poses and sleep timers, body by body (in parallel: each body writes itself).
-        let (states, sleep_on) = (&self.states, self.def.enable_sleep);
-        self.bodies.for_each_live_mut(parallel, BODY_CHUNK, |_, b| {
-            if b.solver_index == 0 {
+        let (states, sleep_on, solver_bodies) = (&self.states, self.def.enable_sleep, &self.solver_bodies);
+        self.bodies.for_each_live_mut(parallel, BODY_CHUNK, |bi, b| {
+            let index = solver_bodies.get(bi as usize).map_or(0, |sb| sb.index);
+            if index == 0 {
                 return;
             }
-            let s = states[b.solver_index as usize];
+            let s = states[index as usize];
             b.force = Vec2::ZERO;
             b.torque = 0.0;
             let finite =
