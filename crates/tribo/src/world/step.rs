@@ -210,9 +210,11 @@ impl World {
             let flag = |bi: u32| flags.get(bi as usize).copied().unwrap_or(false);
             for_each_mut(parallel, &mut self.contacts, CONTACT_CHUNK, |_, slot| {
                 if let Some(c) = slot.as_mut() {
-                    if flag(c.body_a) || flag(c.body_b) {
-                        c.outcome = narrow_phase(c, bodies, shapes, dt);
-                    }
+                    c.outcome = if flag(c.body_a) || flag(c.body_b) {
+                        narrow_phase(c, bodies, shapes, dt)
+                    } else {
+                        NarrowOutcome::Skipped
+                    };
                 }
             });
         } else {
@@ -238,13 +240,13 @@ impl World {
         let mut to_wake = Vec::new();
         let mut touching = core::mem::take(&mut self.touching_contacts);
         touching.clear();
+        // Read only (the outcome of every listed contact was written this step): a serial
+        // pass that wrote each record would make the next parallel pass pull them back.
         for &ci in &active {
-            // Contacts not updated this step read `Skipped` (the outcome is taken below).
-            let Some(c) = self.contacts[ci as usize].as_mut() else {
+            let Some(c) = self.contacts[ci as usize].as_ref() else {
                 continue;
             };
-            let outcome = core::mem::take(&mut c.outcome);
-            match outcome {
+            match c.outcome {
                 NarrowOutcome::Skipped => {}
                 NarrowOutcome::Destroy => to_destroy.push(ci),
                 NarrowOutcome::Updated { touching: now, changed } => {
