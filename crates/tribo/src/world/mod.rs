@@ -124,6 +124,8 @@ pub struct World {
     // Scratch buffers reused every step (no per-step allocation once warm).
     pub(crate) states: Vec<BodyState>,
     pub(crate) sims: Vec<BodySim>,
+    /// The states as the worker threads share them during the substeps (reused).
+    pub(crate) shared_states: Vec<crate::solver::SharedState>,
     pub(crate) contact_solver: ContactSolver,
     pub(crate) candidates: Vec<Candidate>,
     /// Contacts with an awake moving body (narrow phase of the current step).
@@ -181,6 +183,7 @@ impl World {
             scratch_f32: Vec::new(),
             scratch_mark: Vec::new(),
             scratch_flags: Vec::new(),
+            shared_states: Vec::new(),
             solver_bodies: Vec::new(),
             step_count: 0,
             profile: Profile::default(),

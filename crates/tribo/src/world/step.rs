@@ -459,12 +459,16 @@ impl World {
         self.candidates = candidates;
         self.profile.solver_setup = lap.lap();
         if ctx.parallel {
-            // Threads share the states as atomics for the substeps, then copy them back.
-            let shared: Vec<SharedState> = self.states.iter().map(|&s| SharedState::new(s)).collect();
+            // Threads share the states (`SharedState`, one per cache line) for the substeps,
+            // then copy them back; the shared array is kept from step to step.
+            let mut shared = core::mem::take(&mut self.shared_states);
+            shared.clear();
+            shared.extend(self.states.iter().map(|&s| SharedState::new(s)));
             solve_step(ctx, &self.sims, &shared, &mut solver, &mut self.profile);
             for (s, x) in self.states.iter_mut().zip(&shared) {
                 *s = x.load();
             }
+            self.shared_states = shared;
         } else {
             let cells = core::cell::Cell::from_mut(&mut self.states[..]).as_slice_of_cells();
             solve_step(ctx, &self.sims, cells, &mut solver, &mut self.profile);
