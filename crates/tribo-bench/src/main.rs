@@ -49,7 +49,8 @@ struct Args {
     #[arg(long)]
     steps: Option<u32>,
     /// Worker threads for Tribo (`WorldDef::workers`), Box2D (workerCount) and Rapier (its
-    /// rayon pool, only with the `rapier-parallel` feature).
+    /// rayon pool, only with the `rapier-parallel` feature). Above 1, Tribo and Box2D are
+    /// also timed on one thread in the same interleaved runs, for a thread-scaling table.
     #[arg(long, default_value_t = 1)]
     threads: usize,
     /// Engines to time, comma separated (tribo, box2d, rapier).
@@ -87,6 +88,8 @@ struct SceneResult {
 /// Everything measured for one (scene, engine).
 struct EngineResult {
     kind: EngineKind,
+    /// Worker threads asked for (the engine reports what it used in `threads`).
+    threads_asked: usize,
     ms: Vec<f64>,
     build_s: Vec<f64>,
     check: Option<Check>,
@@ -161,6 +164,16 @@ fn run(args: &Args) -> Result<(), BoxError> {
     if !args.no_friction_table && !scaling && kinds.contains(&EngineKind::Tribo) {
         kinds.push(EngineKind::TriboMus15);
     }
+    let mut runs_of: Vec<(EngineKind, usize)> = kinds.iter().map(|&k| (k, args.threads)).collect();
+    if args.threads > 1 && !scaling {
+        // The same engines on one thread, in the same interleaved runs: the speed-up is
+        // measured within one invocation, not across runs minutes apart.
+        for k in [EngineKind::Tribo, EngineKind::Box2d] {
+            if kinds.contains(&k) {
+                runs_of.push((k, 1));
+            }
+        }
+    }
     if args.runs == 0 || args.large_runs == 0 {
         return Err("--runs and --large-runs must be at least 1".into());
     }
@@ -186,7 +199,7 @@ fn run(args: &Args) -> Result<(), BoxError> {
         } else {
             args.runs
         };
-        let results = run_scene(bench, &scene, &kinds, args, runs)?;
+        let results = run_scene(bench, &scene, &runs_of, args, runs)?;
         print_scene_table(bench, &scene, &results, args);
         if let Some(out) = json_out.as_mut() {
             for r in &results {
@@ -220,7 +233,10 @@ fn run(args: &Args) -> Result<(), BoxError> {
         });
     }
     if kinds.contains(&EngineKind::TriboMus15) {
-        print_friction_table(&all_results);
+        print_friction_table(&all_results, args);
+    }
+    if args.threads > 1 && !scaling {
+        print_thread_table(&all_results, args);
     }
     if scaling {
         print_scaling_table(&all_results, &selected, args);
@@ -290,14 +306,15 @@ fn print_header(args: &Args) {
 fn run_scene(
     bench: &BenchScene,
     scene: &SceneFile,
-    kinds: &[EngineKind],
+    kinds: &[(EngineKind, usize)],
     args: &Args,
     runs: usize,
 ) -> Result<Vec<EngineResult>, BoxError> {
     let mut results: Vec<EngineResult> = kinds
         .iter()
-        .map(|&kind| EngineResult {
+        .map(|&(kind, threads_asked)| EngineResult {
             kind,
+            threads_asked,
             ms: Vec::new(),
             build_s: Vec::new(),
             check: None,
@@ -311,7 +328,7 @@ fn run_scene(
     for run in 0..runs {
         for r in results.iter_mut() {
             let t_build = Instant::now();
-            let mut sim = engines::build(r.kind, scene, args.threads)?;
+            let mut sim = engines::build(r.kind, scene, r.threads_asked)?;
             let build_s = t_build.elapsed().as_secs_f64();
             let awake_at_build = sim.awake_count();
             sim.step()?; // untimed first step (index 0)
@@ -330,11 +347,12 @@ fn run_scene(
             let ms = t0.elapsed().as_secs_f64() * 1000.0 / timed as f64;
             let check = check(bench, scene, sim.as_mut());
             eprintln!(
-                "  {} run {}/{} {:<13} {:>9.3} ms/step (build {:.2} s; awake bodies at build/after step 0/end: {}/{}/{}) {}",
+                "  {} run {}/{} {:<13} {:>2}t {:>9.3} ms/step (build {:.2} s; awake bodies at build/after step 0/end: {}/{}/{}) {}",
                 bench.name,
                 run + 1,
                 runs,
                 r.kind.name(),
+                r.threads_asked,
                 ms,
                 build_s,
                 awake_at_build,
@@ -554,12 +572,17 @@ fn print_scene_table(bench: &BenchScene, scene: &SceneFile, results: &[EngineRes
     if !bench.note.is_empty() {
         println!("   note: {}", bench.note);
     }
-    let tribo = results.iter().find(|r| r.kind == EngineKind::Tribo);
+    let main_rows = |r: &&EngineResult| r.threads_asked == args.threads;
+    let tribo = results.iter().filter(main_rows).find(|r| r.kind == EngineKind::Tribo);
     println!(
         "{:<8} {:>7} {:>14} {:>11} {:>14} {:>11} {:>9}  check (last run)",
         "engine", "threads", "median ms/step", "min ms/step", "Tribo/peer med", "Tribo/peer min", "contacts"
     );
-    for r in results.iter().filter(|r| r.kind != EngineKind::TriboMus15) {
+    for r in results
+        .iter()
+        .filter(main_rows)
+        .filter(|r| r.kind != EngineKind::TriboMus15)
+    {
         let (rm, rn) = match tribo {
             Some(t) => (
                 format!("{:.2}", t.median() / r.median()),
@@ -583,21 +606,21 @@ fn print_scene_table(bench: &BenchScene, scene: &SceneFile, results: &[EngineRes
     }
     if args.profile {
         for r in results {
-            println!("  profile {}: {}", r.kind.name(), r.profile);
+            println!("  profile {} ({} threads): {}", r.kind.name(), r.threads, r.profile);
         }
     }
     println!();
 }
 
-fn print_friction_table(all: &[SceneResult]) {
+fn print_friction_table(all: &[SceneResult], args: &Args) {
     println!("== Tribo: cost of the static/dynamic friction model (every shape's μs scaled by 1.5, μd unchanged)");
     println!(
         "{:<14} {:>16} {:>18} {:>8} {:>14} {:>16}  check μs = 1.5 μd (last run)",
         "scene", "μs=μd median ms", "μs=1.5μd median ms", "ratio", "μs=μd min ms", "μs=1.5μd min ms"
     );
     for SceneResult { name, results, .. } in all {
-        let a = results.iter().find(|r| r.kind == EngineKind::Tribo);
-        let b = results.iter().find(|r| r.kind == EngineKind::TriboMus15);
+        let at = |k: EngineKind| results.iter().find(|r| r.kind == k && r.threads_asked == args.threads);
+        let (a, b) = (at(EngineKind::Tribo), at(EngineKind::TriboMus15));
         if let (Some(a), Some(b)) = (a, b) {
             println!(
                 "{:<14} {:>16.3} {:>18.3} {:>8.3} {:>14.3} {:>16.3}  {} {}",
@@ -613,6 +636,43 @@ fn print_friction_table(all: &[SceneResult]) {
         }
     }
     println!("(ratio = μs=1.5μd / μs=μd, medians)");
+}
+
+/// Thread scaling measured within the run: each engine's one-thread time over its
+/// `--threads` time (median over median, min over min).
+fn print_thread_table(all: &[SceneResult], args: &Args) {
+    println!(
+        "== thread scaling in this run: speed-up = ms/step on 1 thread / ms/step on {} (same interleaved runs)",
+        args.threads
+    );
+    println!(
+        "{:<14} {:<8} {:>14} {:>14} {:>12} {:>12} {:>12}",
+        "scene",
+        "engine",
+        "1t median ms",
+        format!("{}t median ms", args.threads),
+        "speed-up med",
+        "speed-up min",
+        "threads used"
+    );
+    for SceneResult { name, results, .. } in all {
+        for k in [EngineKind::Tribo, EngineKind::Box2d] {
+            let at = |t: usize| results.iter().find(|r| r.kind == k && r.threads_asked == t);
+            if let (Some(one), Some(many)) = (at(1), at(args.threads)) {
+                println!(
+                    "{:<14} {:<8} {:>14.3} {:>14.3} {:>12.2} {:>12.2} {:>12}",
+                    name,
+                    k.name(),
+                    one.median(),
+                    many.median(),
+                    one.median() / many.median(),
+                    one.min() / many.min(),
+                    many.threads
+                );
+            }
+        }
+    }
+    println!();
 }
 
 /// The scaling summary: per body count n and engine, ms/step, µs/step per dynamic body and

@@ -76,3 +76,26 @@ fn smallest_scaling_scene_runs_for_every_engine() {
         assert_eq!(r["check_passed"], true, "{engine}: {}", r["check"]);
     }
 }
+
+#[test]
+fn two_threads_also_time_one_thread_in_the_same_run() {
+    let (stdout, records) = run(&[
+        "large_pyramid",
+        "--runs",
+        "1",
+        "--steps",
+        "3",
+        "--threads",
+        "2",
+        "--no-friction-table",
+    ]);
+    assert!(stdout.contains("== thread scaling"), "no thread table in:\n{stdout}");
+    for engine in ["tribo", "box2d"] {
+        for threads in [1, 2] {
+            let found = records
+                .iter()
+                .any(|r| r["scene"] == "large_pyramid" && r["engine"] == engine && r["threads"] == threads);
+            assert!(found, "no {engine} record on {threads} thread(s) in:\n{stdout}");
+        }
+    }
+}
