@@ -134,6 +134,17 @@ pub(crate) struct ContactSolver {
     slots: Vec<Slot>,
 }
 
+/// Wide constraints per block of the substep team's work sharing ([`TeamBlock`]).
+const TEAM_BLOCK: usize = 16;
+
+/// A block of one colour's groups for the substep team: claimed by one thread per pass
+/// (`claimed` holds the number of the last pass that took it); the mutex only hands the
+/// claiming thread its `&mut` (never contended).
+struct TeamBlock<'a> {
+    claimed: core::sync::atomic::AtomicU32,
+    part: std::sync::Mutex<(&'a mut [WideHead], &'a mut [WideContact])>,
+}
+
 /// Wide constraints per parallel chunk of a colour.
 const GROUP_CHUNK: usize = 32;
 
@@ -623,40 +634,58 @@ impl ConstraintSet for ContactSolver {
 impl ContactSolver {
     /// The worker-team substep loop (see [`ConstraintSet::substeps_team`]): one job on
     /// every thread of the pool for all substeps; each thread integrates its range of
-    /// bodies and solves its share of every colour, with a spin barrier after each colour
-    /// and stage. The shares are fixed (thread k takes the k-th chunk), and a colour's
-    /// constraints share no moving body, so the result does not depend on the thread
-    /// count. Only for steps without overflow constraints and mass-ratio groups (scalar
-    /// work the team would have to serialise); those run the per-colour path.
+    /// bodies and solves blocks of every colour (its own share first, then blocks the
+    /// others have not started, as Box2D v3's solver stages steal blocks), with a spin
+    /// barrier after each colour and stage. Each block is solved exactly once per pass and
+    /// a colour's constraints share no moving body, so the result does not depend on the
+    /// thread count or on who solved which block. Only for steps without overflow
+    /// constraints and mass-ratio groups (scalar work the team would have to serialise);
+    /// those run the per-colour path.
     fn team_loop(&mut self, ctx: &StepContext, sims: &[BodySim], states: &[SharedState], times: &mut [f32; 5]) -> bool {
         let threads = rayon::current_num_threads();
         if threads < 2 || !self.overflow.is_empty() || !self.groups.is_empty() || self.wide.is_empty() {
             return false;
         }
-        type Part<'a> = std::sync::Mutex<(&'a mut [WideHead], &'a mut [WideContact])>;
-        let parts: Vec<Vec<Part<'_>>> = split_ranges(&mut self.head, &self.ranges)
+        // Each colour in blocks of TEAM_BLOCK groups. Thread k first takes the k-th share of
+        // the blocks (the same bodies in every colour and pass, so their states stay in its
+        // cache), then helps with the blocks the others have not started, from the far end:
+        // a thread the machine slows down does not hold the others up at every barrier.
+        let colours: Vec<Vec<TeamBlock<'_>>> = split_ranges(&mut self.head, &self.ranges)
             .into_iter()
             .zip(split_ranges(&mut self.wide, &self.ranges))
             .map(|(h, c)| {
-                let chunk = c.len().div_ceil(threads).max(1);
-                h.chunks_mut(chunk)
-                    .zip(c.chunks_mut(chunk))
-                    .map(std::sync::Mutex::new)
+                h.chunks_mut(TEAM_BLOCK)
+                    .zip(c.chunks_mut(TEAM_BLOCK))
+                    .map(|part| TeamBlock {
+                        claimed: core::sync::atomic::AtomicU32::new(0),
+                        part: std::sync::Mutex::new(part),
+                    })
                     .collect()
             })
             .collect();
         let bodies_per_thread = sims.len().div_ceil(threads).max(1);
         let barrier = SpinBarrier::new(threads);
         let times_out = std::sync::Mutex::new([0.0f32; 5]);
-        let each_colour = |k: usize, f: &dyn Fn(&mut WideHead, &mut WideContact)| {
-            for colour in &parts {
-                if let Some(part) = colour.get(k) {
-                    let mut guard = part.lock().unwrap_or_else(|e| e.into_inner());
-                    let (heads, wides) = &mut *guard;
-                    for (h, w) in heads.iter_mut().zip(wides.iter_mut()) {
-                        f(h, w);
+        // `pass` counts the colour passes; every thread runs the same sequence of them, so
+        // their counters agree, and a block is claimed for a pass by stamping its number.
+        let each_colour = |k: usize, pass: &mut u32, f: &dyn Fn(&mut WideHead, &mut WideContact)| {
+            for colour in &colours {
+                *pass += 1;
+                let stamp = *pass;
+                let run = |block: &TeamBlock<'_>| {
+                    if block.claimed.swap(stamp, core::sync::atomic::Ordering::AcqRel) != stamp {
+                        let mut guard = block.part.lock().unwrap_or_else(|e| e.into_inner());
+                        let (heads, wides) = &mut *guard;
+                        for (h, w) in heads.iter_mut().zip(wides.iter_mut()) {
+                            f(h, w);
+                        }
                     }
-                }
+                };
+                let share = colour.len().div_ceil(threads);
+                let (start, end) = ((k * share).min(colour.len()), ((k + 1) * share).min(colour.len()));
+                colour[start..end].iter().for_each(run);
+                colour[end..].iter().rev().for_each(run);
+                colour[..start].iter().rev().for_each(run);
                 barrier.wait();
             }
         };
@@ -665,6 +694,7 @@ impl ContactSolver {
             let bodies = (k * bodies_per_thread).max(1)..((k + 1) * bodies_per_thread).min(sims.len());
             let mut lap = Stopwatch::start();
             let mut t = [0.0f32; 5];
+            let mut pass = 0u32;
             for i in 0..ctx.substeps {
                 let elapsed = i as f32 * ctx.h;
                 for b in bodies.clone() {
@@ -672,9 +702,9 @@ impl ContactSolver {
                 }
                 barrier.wait();
                 t[0] += lap.lap();
-                each_colour(k, &|h, _| contact_wide::warm_start(h, states));
+                each_colour(k, &mut pass, &|h, _| contact_wide::warm_start(h, states));
                 t[1] += lap.lap();
-                each_colour(k, &|h, w| {
+                each_colour(k, &mut pass, &|h, w| {
                     contact_wide::solve::<true, SharedState>(h, w, states, ctx, elapsed)
                 });
                 t[2] += lap.lap();
@@ -683,7 +713,7 @@ impl ContactSolver {
                 }
                 barrier.wait();
                 t[3] += lap.lap();
-                each_colour(k, &|h, w| {
+                each_colour(k, &mut pass, &|h, w| {
                     contact_wide::solve::<false, SharedState>(h, w, states, ctx, elapsed + ctx.h)
                 });
                 t[4] += lap.lap();
