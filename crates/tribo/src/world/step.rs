@@ -120,12 +120,14 @@ impl World {
             for &tree in trees {
                 self.broad_phase.trees[tree as usize].query(s.fat_aabb, s.filter.mask, |_, data| {
                     let other = data as u32;
-                    let Some(o) = self.shapes.at(other) else { return true };
-                    // When both moved, the lower index reports the pair.
-                    if other == si || (o.moved && other < si) || o.body == s.body {
+                    // An existing pair is found in the moved body's short key list before
+                    // the other shape's record is read (most overlaps are existing pairs).
+                    if other == si || exists(pair_key(si, other)) {
                         return true;
                     }
-                    if !s.filter.should_collide(&o.filter) || exists(pair_key(si, other)) {
+                    let Some(o) = self.shapes.at(other) else { return true };
+                    // When both moved, the lower index reports the pair.
+                    if (o.moved && other < si) || o.body == s.body || !s.filter.should_collide(&o.filter) {
                         return true;
                     }
                     if body.is_dynamic() || self.bodies.at(o.body.index).is_some_and(|b| b.is_dynamic()) {
