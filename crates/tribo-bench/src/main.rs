@@ -531,7 +531,52 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
                              "finite": finite}),
             }
         }
-        CheckKind::Rain { half_width } => {
+        CheckKind::Washer { radius } => {
+            let ring = scene
+                .bodies
+                .iter()
+                .position(|b| b.kind == BodyKind::Kinematic)
+                .unwrap_or(0);
+            let r = &scene.bodies[ring];
+            let t = scene.steps as f32 * scene.dt;
+            let c = [
+                r.position[0] + r.linear_velocity[0] * t,
+                r.position[1] + r.linear_velocity[1] * t,
+            ];
+            let expected = r.angle + r.angular_velocity * t;
+            let measured = sim.angle(ring);
+            let tau = std::f32::consts::TAU;
+            let angle_err = (measured - expected + std::f32::consts::PI).rem_euclid(tau) - std::f32::consts::PI;
+            let (mut outside, mut max_r) = (0usize, 0.0f32);
+            for &i in &dynamic {
+                let p = sim.position(i);
+                let d = ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2)).sqrt();
+                if d.is_nan() || d >= radius {
+                    outside += 1;
+                }
+                if d.is_finite() {
+                    max_r = max_r.max(d);
+                }
+            }
+            let passed = finite && outside == 0 && angle_err.abs() < 0.01;
+            Check {
+                passed,
+                text: format!(
+                    "{outside} of {} boxes outside the rim (r < {radius} m of the ring centre; max {max_r:.3} m); \
+                     ring angle {measured:.4} rad vs ω t ≡ {:.4} rad (err {angle_err:.1e})",
+                    dynamic.len(),
+                    measured - angle_err
+                ),
+                json: json!({"boxes_outside": outside, "boxes": dynamic.len(), "max_radius_m": max_r,
+                             "limit_m": radius, "ring_angle_rad": measured, "ring_angle_expected_rad": expected,
+                             "finite": finite}),
+            }
+        }
+        CheckKind::Rain {
+            half_width,
+            max_outside,
+            catch_y,
+        } => {
             let (mut outside, mut y_top, mut y_low) = (0usize, f32::NEG_INFINITY, f32::INFINITY);
             for &i in &dynamic {
                 let p = sim.position(i);
@@ -543,13 +588,18 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
                     y_low = y_low.min(p[1]);
                 }
             }
-            let passed = finite && outside == 0;
+            let passed = finite && outside <= max_outside && (outside == 0 || y_low > catch_y);
             Check {
                 passed,
                 text: format!(
-                    "{outside} of {} bodies outside the container (|x| < {half_width} m, y > 0); \
-                     body centres at y {y_low:.3} … {y_top:.2} m",
-                    dynamic.len()
+                    "{outside} of {} bodies outside the container (|x| < {half_width} m, y > 0; at most \
+                     {max_outside}{}); body centres at y {y_low:.3} … {y_top:.2} m",
+                    dynamic.len(),
+                    if max_outside > 0 {
+                        format!(", caught above y = {catch_y} m")
+                    } else {
+                        String::new()
+                    }
                 ),
                 json: json!({"bodies_outside": outside, "bodies": dynamic.len(), "half_width_m": half_width,
                              "lowest_y_m": y_low, "highest_y_m": y_top, "finite": finite}),

@@ -1,8 +1,8 @@
 //! The benchmark scenes (engine-neutral [`SceneFile`]s) and scene transformations.
 //!
-//! `large_pyramid`, `many_pyramids` and `tumbler` (`tumbler_benchmark`: Box2D's scene with
-//! a kinematic drum instead of a motor-driven dynamic one) come from
-//! `tribo_scenes::scenes`; `smash` is built here following shared/SCENES.md §2 (Box2D v3's
+//! `large_pyramid`, `many_pyramids`, `tumbler` (`tumbler_benchmark`: Box2D's scene with
+//! a kinematic drum instead of a motor-driven dynamic one), `compounds` and `washer` come
+//! from `tribo_scenes::scenes`; `smash` is built here following shared/SCENES.md §2 (Box2D v3's
 //! `CreateSmash`). The scaling run's scenes are `tribo_scenes::scenes::scaling_rain(n)`.
 
 use tribo_scenes::format::{BodyKind, BodySpec, MaterialRef, MaterialSpec, SceneFile, ShapeSpec};
@@ -23,11 +23,23 @@ pub enum CheckKind {
     /// stay inside the drum: |x|, |y| < 9.5 m (the walls' inner faces); the engine's own
     /// drum angle must match ω t within 0.01 rad.
     Tumbler,
+    /// Every box's centre must stay within the washer's rim (`radius` of the ring centre,
+    /// which moves at the ring's constant velocity), and the engine's own ring angle must
+    /// match ω t within 0.01 rad.
+    Washer {
+        /// Inner radius of the rim [m].
+        radius: f32,
+    },
     /// Every body's centre must stay inside the container: |x| < `half_width` (the walls'
-    /// inner faces) and y > 0 (the floor's top face).
+    /// inner faces) and y > 0 (the floor's top face), but for at most `max_outside` bodies,
+    /// which must then be above `catch_y` (caught, not fallen through everything).
     Rain {
         /// Inner half width of the container [m].
         half_width: f32,
+        /// Bodies allowed outside (0: none).
+        max_outside: usize,
+        /// Lowest y [m] a body outside may have.
+        catch_y: f32,
     },
 }
 
@@ -73,6 +85,29 @@ pub fn scenes() -> Vec<BenchScene> {
                    density 50, on a revolute motor; Tribo has no joints yet)",
             ..BenchScene::new("tumbler", tribo_scenes::scenes::tumbler_benchmark, CheckKind::Tumbler)
         },
+        BenchScene {
+            note: "check: body origins (the triangles' base centres) inside the container but for 1 % \
+                   that may bounce over a wall onto the catch segment at y = -80 m (Box2D loses 2)",
+            ..BenchScene::new(
+                "compounds",
+                tribo_scenes::scenes::compounds,
+                CheckKind::Rain {
+                    half_width: tribo_scenes::scenes::COMPOUNDS_INNER_HALF_WIDTH,
+                    max_outside: 30,
+                    catch_y: -81.0,
+                },
+            )
+        },
+        BenchScene {
+            note: "Box2D's boxes report hit events; no engine reports them here",
+            ..BenchScene::new(
+                "washer",
+                tribo_scenes::scenes::washer,
+                CheckKind::Washer {
+                    radius: tribo_scenes::scenes::WASHER_RIM_INNER,
+                },
+            )
+        },
     ]
 }
 
@@ -84,6 +119,8 @@ pub fn scaling_scene(n: usize) -> BenchScene {
         move || tribo_scenes::scenes::scaling_rain(n),
         CheckKind::Rain {
             half_width: tribo_scenes::scenes::rain_half_width(n),
+            max_outside: 0,
+            catch_y: 0.0,
         },
     );
     b.note = "not a Box2D scene: container width ∝ n (constant pile depth), sleep off";

@@ -55,7 +55,14 @@ fn record<'a>(
 #[test]
 fn every_scene_runs_for_every_engine() {
     let (stdout, records) = run(&["all", "--runs", "1", "--steps", "3"]);
-    for scene in ["large_pyramid", "many_pyramids", "smash", "tumbler"] {
+    for scene in [
+        "large_pyramid",
+        "many_pyramids",
+        "smash",
+        "tumbler",
+        "compounds",
+        "washer",
+    ] {
         for engine in ["tribo", "box2d", "rapier"] {
             let r = record(&records, &stdout, scene, engine, &FIELDS);
             assert!(r["ms_per_step_median"]

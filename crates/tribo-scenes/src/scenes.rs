@@ -79,6 +79,16 @@ pub const SCENES: &[SceneEntry] = &[
         build: large_pyramid,
     },
     SceneEntry {
+        name: "compounds",
+        about: "Box2D v3 benchmark: 3 000 bodies of two triangles fall into a container of boxes, 500 steps",
+        build: compounds,
+    },
+    SceneEntry {
+        name: "washer",
+        about: "Box2D v3 benchmark: 8 100 small boxes tumbled by a kinematic ring turning at 25°/s, 500 steps",
+        build: washer,
+    },
+    SceneEntry {
         name: "many_pyramids",
         about: "Box2D v3 benchmark: 20 × 20 pyramids of 55 boxes (22 000 boxes), sleep off, 200 steps",
         build: many_pyramids,
@@ -612,6 +622,130 @@ fn box2d_pyramid(s: &mut SceneFile, base: usize, x_offset: f32, base_y: f32) {
     }
 }
 
+fn offset_box(hx: f32, hy: f32, center: [f32; 2]) -> ShapeSpec {
+    ShapeSpec {
+        center: Some(center),
+        ..box_shape(hx, hy, None)
+    }
+}
+
+fn polygon_shape(vertices: Vec<[f32; 2]>, material: Option<MaterialRef>) -> ShapeSpec {
+    ShapeSpec {
+        kind: "polygon".into(),
+        vertices: Some(vertices),
+        material,
+        ..ShapeSpec::default()
+    }
+}
+
+/// Inner faces of the compounds container: walls at x = ±40 m (half width 0.5 m) and the
+/// ground's top at y = 0.5 m.
+pub const COMPOUNDS_INNER_HALF_WIDTH: f32 = 39.5;
+
+/// Box2D v3's compounds benchmark scene (`CreateCompounds`, shared/SCENES.md §2): 3 000
+/// bodies of two triangles each fall into a container of static boxes.
+pub fn compounds() -> SceneFile {
+    let mut s = scene(
+        "Box2D v3 benchmark compounds: 3 000 two-triangle bodies fall into a box container",
+        500,
+    );
+    s.gravity = [0.0, -10.0];
+    s.enable_sleep = true;
+    s.materials.insert(
+        "triangle".into(),
+        MaterialSpec {
+            density: Some(1.0),
+            friction: Some(0.5),
+            ..MaterialSpec::default()
+        },
+    );
+    let mut ground = body(Some("ground".into()), BodyKind::Static, [0.0, 0.0], 0.0, Vec::new());
+    for i in -40..=40 {
+        ground.shapes.push(offset_box(0.55, 0.5, [i as f32, 0.0]));
+    }
+    for x in [-40.0, 40.0] {
+        for j in 1..=100 {
+            ground.shapes.push(offset_box(0.5, 0.55, [x, j as f32]));
+        }
+    }
+    ground.shapes.push(ShapeSpec {
+        kind: "segment".into(),
+        point1: Some([-800.0, -80.0]),
+        point2: Some([800.0, -80.0]),
+        ..ShapeSpec::default()
+    });
+    s.bodies.push(ground);
+    let left = vec![[-1.0, 0.0], [0.5, 1.0], [0.0, 2.0]];
+    let right = vec![[1.0, 0.0], [-0.5, 1.0], [0.0, 2.0]];
+    let mut shift = 0.25f32;
+    for i in 0..20 {
+        for j in 0..150 {
+            let p = [2.0 * i as f32 - 19.0 + shift, 2.25 * j as f32 + 5.575];
+            shift = -shift;
+            s.bodies.push(body(
+                None,
+                BodyKind::Dynamic,
+                p,
+                0.0,
+                vec![
+                    polygon_shape(left.clone(), named("triangle")),
+                    polygon_shape(right.clone(), named("triangle")),
+                ],
+            ));
+        }
+    }
+    s
+}
+
+/// Centre [m] of the washer's ring at the start.
+pub const WASHER_CENTER: [f32; 2] = [0.0, 10.0];
+
+/// Inner radius [m] of the washer's rim (its paddles reach in to 14 m).
+pub const WASHER_RIM_INNER: f32 = 16.0;
+
+/// Box2D v3's washer benchmark scene (`CreateWasher`, shared/SCENES.md §2): 8 100 small
+/// boxes tumbled by a kinematic ring of 36 rim quads and 4 paddles turning at 25°/s.
+/// Box2D's scene enables hit events on the boxes; no engine reports them here.
+pub fn washer() -> SceneFile {
+    let mut s = scene(
+        "Box2D v3 benchmark washer: 8 100 boxes in a kinematic ring turning at 25°/s",
+        500,
+    );
+    s.gravity = [0.0, -10.0];
+    s.enable_sleep = true;
+    let mut ring = body(Some("ring".into()), BodyKind::Kinematic, WASHER_CENTER, 0.0, Vec::new());
+    ring.angular_velocity = 25f32.to_radians();
+    ring.linear_velocity = [0.001, -0.002];
+    let arc = |r0: f32, r1: f32, a0: f32, a1: f32| {
+        let (a0, a1) = (a0.to_radians(), a1.to_radians());
+        vec![
+            [r0 * a0.cos(), r0 * a0.sin()],
+            [r1 * a0.cos(), r1 * a0.sin()],
+            [r1 * a1.cos(), r1 * a1.sin()],
+            [r0 * a1.cos(), r0 * a1.sin()],
+        ]
+    };
+    for m in 0..36 {
+        let a = 10.0 * m as f32;
+        ring.shapes
+            .push(polygon_shape(arc(WASHER_RIM_INNER, 18.0, a - 1.0, a + 11.0), None));
+    }
+    for m in [0, 9, 18, 27] {
+        let a = 10.0 * m as f32;
+        ring.shapes
+            .push(polygon_shape(arc(14.0, WASHER_RIM_INNER, a, a + 10.0), None));
+    }
+    s.bodies.push(ring);
+    for i in 0..90 {
+        for j in 0..90 {
+            let p = [-9.9 + 0.21 * j as f32, 0.1 + 0.21 * i as f32];
+            s.bodies
+                .push(body(None, BodyKind::Dynamic, p, 0.0, vec![box_shape(0.1, 0.1, None)]));
+        }
+    }
+    s
+}
+
 /// Box2D v3's large_pyramid benchmark scene.
 pub fn large_pyramid() -> SceneFile {
     let mut s = scene("Box2D v3 benchmark large_pyramid", 500);
@@ -702,6 +836,73 @@ mod benchmark_scene_tests {
         let m = s.shape_material(&last.shapes[0]);
         assert_eq!((m.density, m.friction_static, m.friction_dynamic), (1.0, 0.6, 0.6));
         assert_eq!(last.shapes[0].half_extents, Some([0.125, 0.125]));
+    }
+
+    #[test]
+    fn compounds_matches_scenes_md() {
+        let s = compounds();
+        assert_eq!((s.steps, s.gravity, s.enable_sleep), (500, [0.0, -10.0], true));
+        assert_eq!(s.bodies.len(), 1 + 3000);
+        let ground = &s.bodies[0];
+        assert_eq!(ground.kind, BodyKind::Static);
+        // 81 floor boxes, 2 × 100 wall boxes, one catch segment.
+        assert_eq!(ground.shapes.len(), 81 + 200 + 1);
+        assert_eq!(ground.shapes[0].center, Some([-40.0, 0.0]));
+        assert_eq!(ground.shapes[0].half_extents, Some([0.55, 0.5]));
+        assert_eq!(ground.shapes[81].center, Some([-40.0, 1.0]));
+        assert_eq!(ground.shapes[81].half_extents, Some([0.5, 0.55]));
+        assert_eq!(ground.shapes[281].point1, Some([-800.0, -80.0]));
+        // Column-major creation; the shift alternates +0.25, -0.25, ... in creation order.
+        let (first, second, col1) = (&s.bodies[1], &s.bodies[2], &s.bodies[1 + 150]);
+        assert_eq!(first.position, [-19.0 + 0.25, 5.575]);
+        assert_eq!(second.position, [-19.0 - 0.25, 2.25 + 5.575]);
+        assert_eq!(col1.position, [2.0 - 19.0 + 0.25, 5.575]);
+        assert_eq!(first.shapes.len(), 2);
+        assert_eq!(
+            first.shapes[0].vertices,
+            Some(vec![[-1.0, 0.0], [0.5, 1.0], [0.0, 2.0]])
+        );
+        assert_eq!(
+            first.shapes[1].vertices,
+            Some(vec![[1.0, 0.0], [-0.5, 1.0], [0.0, 2.0]])
+        );
+        let m = s.shape_material(&first.shapes[0]);
+        assert_eq!((m.density, m.friction_static, m.friction_dynamic), (1.0, 0.5, 0.5));
+    }
+
+    #[test]
+    fn washer_matches_scenes_md() {
+        let s = washer();
+        assert_eq!((s.steps, s.gravity, s.enable_sleep), (500, [0.0, -10.0], true));
+        assert_eq!(s.bodies.len(), 1 + 90 * 90);
+        let ring = &s.bodies[0];
+        assert_eq!(ring.kind, BodyKind::Kinematic);
+        assert_eq!(ring.position, [0.0, 10.0]);
+        assert!((ring.angular_velocity - 25f32.to_radians()).abs() < 1e-6);
+        assert_eq!(ring.linear_velocity, [0.001, -0.002]);
+        assert_eq!(ring.shapes.len(), 36 + 4);
+        // Every rim quad spans radii 16..18 and 12°; every paddle 14..16 and 10°.
+        for (k, shape) in ring.shapes.iter().enumerate() {
+            let v = shape.vertices.as_ref().expect("polygon");
+            let radii: Vec<f32> = v.iter().map(|p| (p[0] * p[0] + p[1] * p[1]).sqrt()).collect();
+            let (lo, hi) = if k < 36 { (16.0, 18.0) } else { (14.0, 16.0) };
+            for r in radii {
+                assert!((r - lo).abs() < 1e-4 || (r - hi).abs() < 1e-4, "shape {k}: radius {r}");
+            }
+            let a = |p: [f32; 2]| p[1].atan2(p[0]);
+            let span = (a(v[2]) - a(v[0])).rem_euclid(std::f32::consts::TAU).to_degrees();
+            let want = if k < 36 { 12.0 } else { 10.0 };
+            assert!((span - want).abs() < 1e-3, "shape {k}: span {span}°");
+        }
+        let last = s.bodies.last().expect("boxes");
+        assert!((last.position[0] - (-9.9 + 0.21 * 89.0)).abs() < 1e-5);
+        assert!((last.position[1] - (0.1 + 0.21 * 89.0)).abs() < 1e-5);
+        assert_eq!(last.shapes[0].half_extents, Some([0.1, 0.1]));
+        // The boxes start inside the rim (r < 16 m; a box reaches 0.15 m from its centre).
+        for b in &s.bodies[1..] {
+            let d = ((b.position[0] - 0.0).powi(2) + (b.position[1] - 10.0).powi(2)).sqrt();
+            assert!(d + 0.15 < WASHER_RIM_INNER, "box at {:?} starts in the rim", b.position);
+        }
     }
 
     #[test]
