@@ -30,7 +30,7 @@
 use super::contact_solver::{
     build_constraint, end_substep_one, estimate, has_fresh_point, is_new_resting, record_approach, restitution_one,
     solve_one, store_impulses, warm_start_one, ConstraintBodies, ContactConstraint, ContactInput, StepSoftness,
-    MASS_RATIO_GROUP, MAX_LOCAL_SWEEPS,
+    MASS_RATIO_GROUP, MAX_ESTIMATE_SWEEPS, MAX_LOCAL_SWEEPS, ONGOING_ESTIMATE_SWEEPS,
 };
 use super::contact_wide::{self, StoredContact, WideCold, WideContact, WideHead, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
@@ -523,7 +523,14 @@ impl ConstraintSet for ContactSolver {
         if subset.is_empty() {
             return false;
         }
-        estimate(&mut subset, self.up, ctx, trial);
+        // A structure placed at rest (most of the step's contacts new) gets the full sweep
+        // budget; contacts joining a pile that already carries its load, fewer.
+        let max_sweeps = if 2 * subset.len() >= self.slots.len() {
+            MAX_ESTIMATE_SWEEPS
+        } else {
+            ONGOING_ESTIMATE_SWEEPS
+        };
+        estimate(&mut subset, self.up, ctx, trial, max_sweeps);
         // `estimate` sorted the subset: find each constraint's slot by its contact.
         let mut by_contact: Vec<(u32, Slot)> = slots.iter().map(|&s| (self.get(s).contact, s)).collect();
         by_contact.sort_unstable_by_key(|x| x.0);
