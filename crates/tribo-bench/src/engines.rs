@@ -91,6 +91,8 @@ pub trait Sim {
     fn threads(&self) -> usize;
     /// Dynamic bodies currently awake.
     fn awake_count(&mut self) -> usize;
+    /// Sets a kinematic body's velocity [m/s] and angular velocity [rad/s] (scene hooks).
+    fn set_kinematic_velocity(&mut self, i: usize, v: [f32; 2], w: f32) -> Result<(), BoxError>;
     /// Called after each timed step when `--profile` is on.
     fn profile_sample(&mut self) {}
     /// Per-stage profile of the sampled steps, if the engine has one.
@@ -186,6 +188,12 @@ mod tribo_sim {
         }
         fn threads(&self) -> usize {
             self.world.def().workers as usize
+        }
+        fn set_kinematic_velocity(&mut self, i: usize, v: [f32; 2], w: f32) -> Result<(), BoxError> {
+            let id = self.bodies[i];
+            self.world.set_body_linear_velocity(id, Vec2::new(v[0], v[1]))?;
+            self.world.set_body_angular_velocity(id, w)?;
+            Ok(())
         }
         fn awake_count(&mut self) -> usize {
             self.bodies
@@ -378,6 +386,12 @@ mod box2d_sim {
                 None => Ok(()),
             }
         }
+        fn set_kinematic_velocity(&mut self, i: usize, vel: [f32; 2], w: f32) -> Result<(), BoxError> {
+            let mut body = self.world.body(self.bodies[i])?;
+            body.set_linear_velocity(v(vel))?;
+            body.set_angular_velocity(w)?;
+            Ok(())
+        }
         fn position(&mut self, i: usize) -> [f32; 2] {
             match self.world.body(self.bodies[i]).and_then(|b| b.position()) {
                 Ok(p) => [p.x, p.y],
@@ -567,6 +581,12 @@ mod rapier_sim {
     impl Sim for RapierSim {
         fn step(&mut self) -> Result<(), BoxError> {
             self.world.step();
+            Ok(())
+        }
+        fn set_kinematic_velocity(&mut self, i: usize, vel: [f32; 2], w: f32) -> Result<(), BoxError> {
+            let rb = &mut self.world.bodies[self.bodies[i]];
+            rb.set_linvel(v(vel), true);
+            rb.set_angvel(w, true);
             Ok(())
         }
         fn position(&mut self, i: usize) -> [f32; 2] {

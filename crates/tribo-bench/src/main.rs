@@ -331,17 +331,20 @@ fn run_scene(
             let mut sim = engines::build(r.kind, scene, r.threads_asked)?;
             let build_s = t_build.elapsed().as_secs_f64();
             let awake_at_build = sim.awake_count();
+            if let Some(hook) = bench.hook {
+                hook(0, sim.as_mut(), scene)?;
+            }
             sim.step()?; // untimed first step (index 0)
             let awake_after_first = sim.awake_count();
             let t0 = Instant::now();
-            if args.profile {
-                for _ in 0..timed {
-                    sim.step()?;
-                    sim.profile_sample();
+            // The scene's hook runs inside the timed loop (Box2D's driver does the same).
+            for n in 1..=timed {
+                if let Some(hook) = bench.hook {
+                    hook(n, sim.as_mut(), scene)?;
                 }
-            } else {
-                for _ in 0..timed {
-                    sim.step()?;
+                sim.step()?;
+                if args.profile {
+                    sim.profile_sample();
                 }
             }
             let ms = t0.elapsed().as_secs_f64() * 1000.0 / timed as f64;

@@ -5,6 +5,8 @@
 //! from `tribo_scenes::scenes`; `smash` is built here following shared/SCENES.md §2 (Box2D v3's
 //! `CreateSmash`). The scaling run's scenes are `tribo_scenes::scenes::scaling_rain(n)`.
 
+use crate::engines::BoxError;
+use crate::engines::Sim;
 use tribo_scenes::format::{BodyKind, BodySpec, MaterialRef, MaterialSpec, SceneFile, ShapeSpec};
 
 /// What the stability check of a scene looks at.
@@ -43,6 +45,10 @@ pub enum CheckKind {
     },
 }
 
+/// A per-step hook: called before step `n` (0 = the untimed first step) with the engine
+/// and the scene, inside the timing loop as Box2D's benchmark driver does.
+pub type Hook = fn(n: u32, sim: &mut dyn Sim, scene: &SceneFile) -> Result<(), BoxError>;
+
 /// A benchmark scene.
 pub struct BenchScene {
     /// Name on the command line and in the JSON.
@@ -53,6 +59,8 @@ pub struct BenchScene {
     pub check: CheckKind,
     /// How the scene differs from Box2D's, printed under the table header ("" = none).
     pub note: &'static str,
+    /// Called before every step, if any.
+    pub hook: Option<Hook>,
 }
 
 impl BenchScene {
@@ -62,6 +70,7 @@ impl BenchScene {
             build: Box::new(build),
             check,
             note: "",
+            hook: None,
         }
     }
 }
@@ -95,6 +104,18 @@ pub fn scenes() -> Vec<BenchScene> {
                     half_width: tribo_scenes::scenes::COMPOUNDS_INNER_HALF_WIDTH,
                     max_outside: 30,
                     catch_y: -81.0,
+                },
+            )
+        },
+        BenchScene {
+            hook: Some(junkyard_hook),
+            ..BenchScene::new(
+                "junkyard",
+                tribo_scenes::scenes::junkyard,
+                CheckKind::Rain {
+                    half_width: tribo_scenes::scenes::JUNKYARD_INNER_HALF_WIDTH,
+                    max_outside: 0,
+                    catch_y: 0.0,
                 },
             )
         },
@@ -228,4 +249,14 @@ mod tests {
         let m = s.shape_material(&s.bodies[1].shapes[0]);
         assert!((m.friction_static - 0.9).abs() < 1e-6 && (m.friction_dynamic - 0.6).abs() < 1e-6);
     }
+}
+
+/// Junkyard's pusher (the last body): before step `n` its velocity is set so that it
+/// reaches [`tribo_scenes::scenes::junkyard_pusher_x`] at the end of the step, as Box2D's
+/// `b2Body_SetTargetTransform` does (y stays 0, no rotation).
+fn junkyard_hook(n: u32, sim: &mut dyn Sim, scene: &SceneFile) -> Result<(), BoxError> {
+    let pusher = scene.bodies.len() - 1;
+    let x = sim.position(pusher)[0];
+    let target = tribo_scenes::scenes::junkyard_pusher_x(n);
+    sim.set_kinematic_velocity(pusher, [(target - x) / scene.dt, 0.0], 0.0)
 }

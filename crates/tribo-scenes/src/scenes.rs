@@ -89,6 +89,11 @@ pub const SCENES: &[SceneEntry] = &[
         build: washer,
     },
     SceneEntry {
+        name: "junkyard",
+        about: "Box2D v3 benchmark: 8 000 pentagons in a container (the pusher stands still here; the benchmark moves it), 800 steps",
+        build: junkyard,
+    },
+    SceneEntry {
         name: "many_pyramids",
         about: "Box2D v3 benchmark: 20 × 20 pyramids of 55 boxes (22 000 boxes), sleep off, 200 steps",
         build: many_pyramids,
@@ -746,6 +751,67 @@ pub fn washer() -> SceneFile {
     s
 }
 
+/// Inner faces of the junkyard container: walls at x = ±80 m (half width 0.5 m).
+pub const JUNKYARD_INNER_HALF_WIDTH: f32 = 79.5;
+
+/// The junkyard pusher's target x [m] before step `n` (shared/SCENES.md §2
+/// `StepJunkyard`): 60 sin(0.2 · n/60), y = 0, no rotation.
+pub fn junkyard_pusher_x(n: u32) -> f32 {
+    60.0 * (0.2 * n as f32 / 60.0).sin()
+}
+
+/// Box2D v3's junkyard benchmark scene (`CreateJunkyard`, shared/SCENES.md §2): 8 000
+/// pentagons in a container of static boxes, stirred by a kinematic pusher (the last
+/// body) that a per-step hook drives to [`junkyard_pusher_x`]. The scene file alone has
+/// the pusher at rest; the benchmark sets its velocity before every step.
+pub fn junkyard() -> SceneFile {
+    let mut s = scene(
+        "Box2D v3 benchmark junkyard: 8 000 pentagons stirred by a kinematic pusher",
+        800,
+    );
+    s.gravity = [0.0, -10.0];
+    s.enable_sleep = true;
+    let mut ground = body(Some("ground".into()), BodyKind::Static, [0.0, 0.0], 0.0, Vec::new());
+    for i in -80..=80 {
+        ground.shapes.push(offset_box(0.55, 0.5, [i as f32, 0.0]));
+    }
+    for x in [-80.0, 80.0] {
+        for j in 1..=50 {
+            ground.shapes.push(offset_box(0.5, 0.55, [x, j as f32]));
+        }
+    }
+    s.bodies.push(ground);
+    let step = std::f32::consts::PI * (5f32.sqrt() - 1.0);
+    let pentagon: Vec<[f32; 2]> = (0..5)
+        .map(|n| {
+            let (sn, cs) = (n as f32 * step).sin_cos();
+            [0.25 * cs, 0.25 * sn]
+        })
+        .collect();
+    let mut shift = -0.1f32;
+    for i in 0..200 {
+        for j in 0..40 {
+            let p = [0.75 * i as f32 - 75.0 + shift, j as f32 + 15.0];
+            shift = -shift;
+            s.bodies.push(body(
+                None,
+                BodyKind::Dynamic,
+                p,
+                0.0,
+                vec![polygon_shape(pentagon.clone(), None)],
+            ));
+        }
+    }
+    s.bodies.push(body(
+        Some("pusher".into()),
+        BodyKind::Kinematic,
+        [0.0, 0.0],
+        0.0,
+        vec![offset_box(2.0, 4.0, [0.0, 4.0])],
+    ));
+    s
+}
+
 /// Box2D v3's large_pyramid benchmark scene.
 pub fn large_pyramid() -> SceneFile {
     let mut s = scene("Box2D v3 benchmark large_pyramid", 500);
@@ -868,6 +934,34 @@ mod benchmark_scene_tests {
         );
         let m = s.shape_material(&first.shapes[0]);
         assert_eq!((m.density, m.friction_static, m.friction_dynamic), (1.0, 0.5, 0.5));
+    }
+
+    #[test]
+    fn junkyard_matches_scenes_md() {
+        let s = junkyard();
+        assert_eq!((s.steps, s.gravity, s.enable_sleep), (800, [0.0, -10.0], true));
+        assert_eq!(s.bodies.len(), 1 + 8000 + 1);
+        let ground = &s.bodies[0];
+        assert_eq!(ground.shapes.len(), 161 + 100);
+        assert_eq!(ground.shapes[0].center, Some([-80.0, 0.0]));
+        assert_eq!(ground.shapes[161].center, Some([-80.0, 1.0]));
+        // Column-major; the shift alternates -0.1, +0.1, ... in creation order.
+        assert_eq!(s.bodies[1].position, [-75.0 - 0.1, 15.0]);
+        assert_eq!(s.bodies[2].position, [-75.0 + 0.1, 16.0]);
+        assert_eq!(s.bodies[1 + 40].position, [0.75 - 75.0 - 0.1, 15.0]);
+        let v = s.bodies[1].shapes[0].vertices.as_ref().expect("pentagon");
+        assert_eq!(v.len(), 5);
+        for (n, p) in v.iter().enumerate() {
+            let a = n as f32 * std::f32::consts::PI * (5f32.sqrt() - 1.0);
+            assert!((p[0] - 0.25 * a.cos()).abs() < 1e-6 && (p[1] - 0.25 * a.sin()).abs() < 1e-6);
+        }
+        let pusher = s.bodies.last().expect("pusher");
+        assert_eq!((pusher.kind, pusher.position), (BodyKind::Kinematic, [0.0, 0.0]));
+        assert_eq!(pusher.shapes[0].half_extents, Some([2.0, 4.0]));
+        assert_eq!(pusher.shapes[0].center, Some([0.0, 4.0]));
+        // The hook's target: 60 sin(0.2 n / 60), a full swing of ±60 m every 2π·300 steps.
+        assert_eq!(junkyard_pusher_x(0), 0.0);
+        assert!((junkyard_pusher_x(300) - 60.0 * 1f32.sin()).abs() < 1e-4);
     }
 
     #[test]
