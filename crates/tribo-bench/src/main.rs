@@ -498,12 +498,7 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
                 .position(|b| b.kind == BodyKind::Kinematic)
                 .unwrap_or(0);
             let c = scene.bodies[drum].position;
-            let t = scene.steps as f32 * scene.dt;
-            let expected = scene.bodies[drum].angle + scene.bodies[drum].angular_velocity * t;
-            let measured = sim.angle(drum);
-            // Difference wrapped to (−π, π].
-            let tau = std::f32::consts::TAU;
-            let angle_err = (measured - expected + std::f32::consts::PI).rem_euclid(tau) - std::f32::consts::PI;
+            let (measured, expected, angle_err) = kinematic_angle(scene, sim, drum);
             let (s, co) = expected.sin_cos();
             let limit = 9.5f32;
             let (mut outside, mut max_abs) = (0usize, 0.0f32);
@@ -546,10 +541,7 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
                 r.position[0] + r.linear_velocity[0] * t,
                 r.position[1] + r.linear_velocity[1] * t,
             ];
-            let expected = r.angle + r.angular_velocity * t;
-            let measured = sim.angle(ring);
-            let tau = std::f32::consts::TAU;
-            let angle_err = (measured - expected + std::f32::consts::PI).rem_euclid(tau) - std::f32::consts::PI;
+            let (measured, expected, angle_err) = kinematic_angle(scene, sim, ring);
             let (mut outside, mut max_r) = (0usize, 0.0f32);
             for &i in &dynamic {
                 let p = sim.position(i);
@@ -609,6 +601,17 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
             }
         }
     }
+}
+
+/// A kinematic body's angle after the run: (the engine's, ω t from the scene, their
+/// difference wrapped to (−π, π]).
+fn kinematic_angle(scene: &SceneFile, sim: &mut dyn Sim, body: usize) -> (f32, f32, f32) {
+    let b = &scene.bodies[body];
+    let expected = b.angle + b.angular_velocity * scene.steps as f32 * scene.dt;
+    let measured = sim.angle(body);
+    let pi = std::f32::consts::PI;
+    let err = (measured - expected + pi).rem_euclid(std::f32::consts::TAU) - pi;
+    (measured, expected, err)
 }
 
 fn print_scene_table(bench: &BenchScene, scene: &SceneFile, results: &[EngineResult], args: &Args) {

@@ -643,6 +643,22 @@ fn polygon_shape(vertices: Vec<[f32; 2]>, material: Option<MaterialRef>) -> Shap
     }
 }
 
+/// The static container of Box2D's compounds and junkyard scenes: floor boxes half
+/// (0.55, 0.5) at x = −`half_count` … `half_count` step 1, y = 0, and at x = ±`half_count`
+/// walls of `wall_boxes` boxes half (0.5, 0.55) at y = 1, 2, …
+fn box_container(half_count: i32, wall_boxes: i32) -> BodySpec {
+    let mut ground = body(Some("ground".into()), BodyKind::Static, [0.0, 0.0], 0.0, Vec::new());
+    for i in -half_count..=half_count {
+        ground.shapes.push(offset_box(0.55, 0.5, [i as f32, 0.0]));
+    }
+    for x in [-half_count as f32, half_count as f32] {
+        for j in 1..=wall_boxes {
+            ground.shapes.push(offset_box(0.5, 0.55, [x, j as f32]));
+        }
+    }
+    ground
+}
+
 /// Inner faces of the compounds container: walls at x = ±40 m (half width 0.5 m) and the
 /// ground's top at y = 0.5 m.
 pub const COMPOUNDS_INNER_HALF_WIDTH: f32 = 39.5;
@@ -664,15 +680,7 @@ pub fn compounds() -> SceneFile {
             ..MaterialSpec::default()
         },
     );
-    let mut ground = body(Some("ground".into()), BodyKind::Static, [0.0, 0.0], 0.0, Vec::new());
-    for i in -40..=40 {
-        ground.shapes.push(offset_box(0.55, 0.5, [i as f32, 0.0]));
-    }
-    for x in [-40.0, 40.0] {
-        for j in 1..=100 {
-            ground.shapes.push(offset_box(0.5, 0.55, [x, j as f32]));
-        }
-    }
+    let mut ground = box_container(40, 100);
     ground.shapes.push(ShapeSpec {
         kind: "segment".into(),
         point1: Some([-800.0, -80.0]),
@@ -771,16 +779,7 @@ pub fn junkyard() -> SceneFile {
     );
     s.gravity = [0.0, -10.0];
     s.enable_sleep = true;
-    let mut ground = body(Some("ground".into()), BodyKind::Static, [0.0, 0.0], 0.0, Vec::new());
-    for i in -80..=80 {
-        ground.shapes.push(offset_box(0.55, 0.5, [i as f32, 0.0]));
-    }
-    for x in [-80.0, 80.0] {
-        for j in 1..=50 {
-            ground.shapes.push(offset_box(0.5, 0.55, [x, j as f32]));
-        }
-    }
-    s.bodies.push(ground);
+    s.bodies.push(box_container(80, 50));
     let step = std::f32::consts::PI * (5f32.sqrt() - 1.0);
     let pentagon: Vec<[f32; 2]> = (0..5)
         .map(|n| {
