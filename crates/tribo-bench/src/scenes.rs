@@ -255,7 +255,7 @@ mod tests {
 /// reaches [`tribo_scenes::scenes::junkyard_pusher_x`] at the end of the step, as Box2D's
 /// `b2Body_SetTargetTransform` does (y stays 0, no rotation).
 fn junkyard_hook(n: u32, sim: &mut dyn Sim, scene: &SceneFile) -> Result<(), BoxError> {
-    let pusher = scene.bodies.len() - 1;
+    let pusher = scene.bodies.len().saturating_sub(1);
     let x = sim.position(pusher)[0];
     let target = tribo_scenes::scenes::junkyard_pusher_x(n);
     sim.set_kinematic_velocity(pusher, [(target - x) / scene.dt, 0.0], 0.0)
