@@ -128,7 +128,8 @@ pub struct World {
     pub(crate) shared_states: Vec<crate::solver::SharedState>,
     pub(crate) contact_solver: ContactSolver,
     pub(crate) candidates: Vec<Candidate>,
-    /// Contacts with an awake moving body (narrow phase of the current step).
+    /// Contacts the narrow phase of the current step listed: those with an awake moving
+    /// body, or every contact slot when most bodies are awake (each then tests its bodies).
     pub(crate) active_contacts: Vec<u32>,
     /// The touching ones among them after the narrow phase (solver and islands).
     pub(crate) touching_contacts: Vec<u32>,

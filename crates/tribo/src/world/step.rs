@@ -635,7 +635,8 @@ const BODY_CHUNK: usize = 256;
 /// Contacts per parallel chunk of the narrow phase and the impulse store.
 const CONTACT_CHUNK: usize = 256;
 
-/// How many contacts ahead the solver's candidate pass asks for the bodies' records.
+/// How many contacts ahead the solver's candidate pass asks for the bodies' `SolverBody`
+/// entries.
 const PREFETCH_CONTACTS: usize = 8;
 
 /// Contact lists up to this long are searched for an existing pair instead of the pair
