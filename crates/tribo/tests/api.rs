@@ -479,6 +479,78 @@ fn fast_body_does_not_tunnel_through_thin_ground() {
 }
 
 #[test]
+fn boxes_hitting_a_wall_overlap_it_by_less_than_half_their_thickness() {
+    // A box of half size h (thickness h from its centre) slides without gravity into a
+    // static wall at speeds below and above the broad phase's sweep threshold (h/2 per
+    // step: 30 h m/s at 1/60 s), from 8 start points spread over one step's travel (how late
+    // a pair is found depends on where the box stands when its fat box is renewed). Below
+    // the threshold the pair may be found late, so the box can enter the wall by up to h/2
+    // for a step before the contact pushes it out (Box2D's behaviour below its continuous
+    // threshold); above it, the swept box holds the whole step's motion, so the pair exists
+    // before the box arrives and the speculative contact stops it at the face (within 1 cm:
+    // twice the soft contact's 5 mm slop). The deepest overlap is measured from the box
+    // centre's x; no box may end beyond the face.
+    for h in [0.1f32, 0.5] {
+        let threshold = 30.0 * h;
+        for (factor, limit) in [
+            (0.5, h / 2.0),
+            (0.97, h / 2.0),
+            (1.03, 0.01),
+            (3.0, 0.01),
+            (10.0, 0.01),
+            (30.0, 0.01),
+        ] {
+            let speed = factor * threshold;
+            let mut deepest = 0.0f32;
+            for phase in 0..8 {
+                let mut world = World::new(WorldDef {
+                    gravity: Vec2::ZERO,
+                    ..WorldDef::default()
+                })
+                .unwrap();
+                let wall = world.create_body(&BodyDef::fixed(Vec2::new(10.0, 0.0))).unwrap();
+                world
+                    .create_shape(
+                        wall,
+                        &ShapeDef::default(),
+                        &Shape::Polygon(Polygon::new_box(1.0, 5.0).unwrap()),
+                    )
+                    .unwrap();
+                let travel = speed * DT;
+                let start = 9.0 - h - 0.3 - 2.0 * travel - travel * phase as f32 / 8.0;
+                let b = world
+                    .create_body(&BodyDef {
+                        linear_velocity: Vec2::new(speed, 0.0),
+                        fixed_rotation: true,
+                        ..BodyDef::dynamic(Vec2::new(start, 0.0))
+                    })
+                    .unwrap();
+                world
+                    .create_shape(
+                        b,
+                        &ShapeDef::default(),
+                        &Shape::Polygon(Polygon::new_box(h, h).unwrap()),
+                    )
+                    .unwrap();
+                for _ in 0..60 {
+                    world.step(DT).unwrap();
+                    let x = world.body_position(b).unwrap().x;
+                    deepest = deepest.max(x + h - 9.0);
+                }
+                assert!(
+                    world.body_position(b).unwrap().x + h < 9.0 + limit,
+                    "h {h}, {speed} m/s: box beyond the face"
+                );
+            }
+            assert!(
+                deepest < limit,
+                "h {h}, {speed} m/s: overlap {deepest} m (limit {limit} m)"
+            );
+        }
+    }
+}
+
+#[test]
 fn runs_are_bit_identical() {
     fn run() -> Vec<[u32; 6]> {
         let mut world = World::new(WorldDef::default()).unwrap();

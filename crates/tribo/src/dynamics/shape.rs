@@ -74,12 +74,16 @@ pub(crate) struct ShapeRecord {
     /// Fat box stored in the tree [m].
     pub fat_aabb: Aabb,
     /// The shape's box at its body's last pose, grown by the speculative distance and
-    /// swept along the last step's motion [m] (inside `fat_aabb`): the narrow phase skips
+    /// swept along the next step's motion beyond `sweep_free` [m] (inside `fat_aabb`;
+    /// `crate::world::shape_box`): the narrow phase skips
     /// the manifold of a pair whose boxes are apart.
     pub aabb: Aabb,
     /// Room [m] between `aabb` and `fat_aabb` when the fat box is renewed
     /// ([`crate::collision::broad_phase::aabb_margin`]).
     pub margin: f32,
+    /// How far [m] the shape may move in one step before its box is swept along the motion
+    /// ([`crate::collision::broad_phase::sweep_free`]).
+    pub sweep_free: f32,
     /// Set when the fat box was replaced this step (the broad phase looks for new pairs).
     pub moved: bool,
 }

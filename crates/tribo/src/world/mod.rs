@@ -18,7 +18,7 @@ pub use query::{QueryFilter, RayResult};
 
 pub(crate) use ids::Arena;
 
-use crate::collision::broad_phase::{aabb_margin, BroadPhase, MOVING_TREE, STATIC_TREE};
+use crate::collision::broad_phase::{aabb_margin, sweep_free, BroadPhase, MOVING_TREE, STATIC_TREE};
 use crate::collision::contact::Contact;
 use crate::dynamics::body::Body;
 use crate::dynamics::shape::ShapeRecord;
@@ -566,11 +566,12 @@ impl World {
             fat_aabb: Aabb::new(Vec2::ZERO, Vec2::ZERO),
             aabb: Aabb::new(Vec2::ZERO, Vec2::ZERO),
             margin,
+            sweep_free: sweep_free(geometry),
             moved: false,
         };
         let (index, generation) = self.shapes.insert(record);
         let id = ShapeId { index, generation };
-        let aabb = shape_box(geometry, xf, v, 0.0);
+        let aabb = shape_box(geometry, xf, v, 0.0, 0.0);
         let fat = aabb.expand(margin);
         let proxy = self.broad_phase.create_proxy(tree, fat, def.filter.category, index);
         if let Some(s) = self.shapes.at_mut(index) {
@@ -790,7 +791,7 @@ impl World {
             let Some(s) = self.shapes.get_mut(sid.index, sid.generation) else {
                 continue;
             };
-            let aabb = shape_box(&s.geometry, xf, v, dt);
+            let aabb = shape_box(&s.geometry, xf, v, dt, s.sweep_free);
             s.aabb = aabb;
             if !s.fat_aabb.contains(aabb) || dt == 0.0 {
                 let fat = aabb.expand(s.margin);
@@ -917,11 +918,16 @@ impl World {
 }
 
 /// The box a shape needs in the broad phase: its tight box grown by the speculative
-/// distance and swept along `v·dt` (so a fast body's pairs exist before it gets there).
-pub(crate) fn shape_box(geometry: &Shape, xf: Transform, v: Vec2, dt: f32) -> Aabb {
+/// distance and, when the step's motion `|v|·dt` exceeds `free` [m] ([`sweep_free`]),
+/// swept along the motion (so a fast body's pairs exist before it gets there). The growth
+/// by the speculative distance already holds the shape along the first
+/// `SPECULATIVE_DISTANCE` of the motion, so the sweep is that much shorter and still
+/// holds every pose of the step.
+pub(crate) fn shape_box(geometry: &Shape, xf: Transform, v: Vec2, dt: f32, free: f32) -> Aabb {
     let aabb = geometry.aabb(xf).expand(SPECULATIVE_DISTANCE);
-    if dt > 0.0 {
-        let d = v * dt;
+    let motion = v.length() * dt;
+    if dt > 0.0 && motion > free.max(SPECULATIVE_DISTANCE) {
+        let d = v * (dt * (1.0 - SPECULATIVE_DISTANCE / motion));
         aabb.union(Aabb::new(aabb.min + d, aabb.max + d))
     } else {
         aabb
@@ -955,4 +961,46 @@ fn validate_geometry(g: &Shape) -> Result<()> {
         Shape::Polygon(_) => {}
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Polygon;
+
+    fn square() -> Shape {
+        Shape::Polygon(Polygon::new_box(0.1, 0.1).unwrap())
+    }
+
+    /// The shape's own (tight) box at `xf` moved by `d`.
+    fn moved(g: &Shape, xf: Transform, d: Vec2) -> Aabb {
+        g.aabb(Transform { p: xf.p + d, q: xf.q })
+    }
+
+    #[test]
+    fn a_slow_shape_keeps_its_unswept_box() {
+        // half 0.1 m: thickness 0.1 m, free 0.05 m per step (sweep_free); 2 m/s at 1/60 s
+        // moves 0.033 m < 0.05 m.
+        let (g, xf, dt) = (square(), Transform::new(Vec2::new(1.0, 2.0), 0.3), 1.0 / 60.0);
+        let free = sweep_free(&g);
+        assert!((free - 0.05).abs() < 1e-6, "{free}");
+        let b = shape_box(&g, xf, Vec2::new(2.0, 0.0), dt, free);
+        assert_eq!(b, moved(&g, xf, Vec2::ZERO).expand(SPECULATIVE_DISTANCE));
+    }
+
+    #[test]
+    fn a_fast_shape_box_covers_its_whole_motion() {
+        // 30 m/s: 0.5 m per step, more than the free 0.05 m, so the box is swept; the sweep
+        // is 2 cm short of the motion, which the growth by the speculative distance makes
+        // up: the box holds the shape at every pose of the step (checked at 1/16 steps).
+        let (g, xf, dt) = (square(), Transform::new(Vec2::new(0.0, 5.0), 0.7), 1.0 / 60.0);
+        let v = Vec2::new(3.0, -30.0);
+        let d = v * dt;
+        let b = shape_box(&g, xf, v, dt, sweep_free(&g));
+        for k in 0..=16 {
+            assert!(b.contains(moved(&g, xf, d * (k as f32 / 16.0))), "pose {k}/16 outside");
+        }
+        // Not more than that: the pose a speculative distance further is outside.
+        assert!(!b.contains(moved(&g, xf, d * (1.0 + 1.5 * SPECULATIVE_DISTANCE / d.length()))));
+    }
 }
