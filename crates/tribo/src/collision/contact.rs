@@ -52,17 +52,15 @@ pub(crate) struct PointState {
 /// A contact between two shapes (internal record).
 ///
 /// Laid out by use (`repr(C)`, whole cache lines): the passes in contact order that touch
-/// only a little of each record — the narrow phase's verdicts, the solver's candidates,
-/// the impulse store — find what they need (the liveness flag, `touching`, the outcome, the
-/// bodies, the point states) in the first two lines; the recycling basis and the shape ids,
-/// read only by the narrow phase and events, come last.
+/// only a little of each record — the awake test before the narrow phase, the impulse
+/// store — find what they need (the liveness flag, `touching`, the bodies, the point
+/// states) in the first two lines; the recycling basis and the shape ids, read only by the
+/// narrow phase and events, come last.
 #[derive(Clone, Debug)]
 #[repr(C, align(64))]
 pub(crate) struct Contact {
     /// Whether the manifold has points.
     pub touching: bool,
-    /// What the narrow phase of the current step found (read back in contact order).
-    pub outcome: NarrowOutcome,
     /// Body slot indices.
     pub body_a: u32,
     pub body_b: u32,
@@ -258,7 +256,6 @@ pub(crate) fn blank_contact() -> Contact {
         rolling_impulse: 0.0,
         touching: false,
         basis: RecycleBasis::default(),
-        outcome: NarrowOutcome::Skipped,
     }
 }
 

@@ -94,6 +94,31 @@ impl Candidate {
     };
 }
 
+/// The candidates of a step: `slots` indexed by contact, `list` the contacts to solve (in
+/// contact order); candidate `i` is `slots[list[i]]`.
+#[derive(Clone, Copy)]
+pub(crate) struct Candidates<'a> {
+    slots: &'a [Candidate],
+    list: &'a [u32],
+}
+
+impl<'a> Candidates<'a> {
+    pub fn new(slots: &'a [Candidate], list: &'a [u32]) -> Candidates<'a> {
+        Candidates { slots, list }
+    }
+
+    /// The `i`-th candidate.
+    #[inline]
+    pub fn get(&self, i: usize) -> Option<&'a Candidate> {
+        self.slots.get(*self.list.get(i)? as usize)
+    }
+
+    /// The candidates in order.
+    pub fn iter(&self) -> impl Iterator<Item = &'a Candidate> + '_ {
+        self.list.iter().filter_map(|&ci| self.slots.get(ci as usize))
+    }
+}
+
 /// A light body's constraints, solved again ⌈M/m⌉ times per relax pass.
 struct Group {
     members: Vec<(Slot, ContactConstraint)>,
@@ -206,7 +231,7 @@ impl ContactSolver {
         ctx: &StepContext,
         states: &[S],
         sims: &[BodySim],
-        candidates: &[Candidate],
+        candidates: Candidates<'_>,
     ) {
         self.overflow.clear();
         self.fresh.clear();
@@ -221,7 +246,7 @@ impl ContactSolver {
         let mut light: Vec<(u32, u32)> = Vec::new(); // (light body state, sweeps)
         self.contact_of.clear();
         self.contacts_ascend = true;
-        for cand in candidates {
+        for cand in candidates.iter() {
             if self.contact_of.last().is_some_and(|&last| last >= cand.contact) {
                 self.contacts_ascend = false;
             }
@@ -388,7 +413,7 @@ impl ContactSolver {
     /// through a light body between a heavy one and the ground only at a rate of about m/M
     /// per sweep, so a 100:1 stack needs ~100 sweeps where one is enough for equal masses.
     /// Only when some body is loaded ([`super::any_load`]).
-    fn build_groups(&mut self, mut light: Vec<(u32, u32)>, candidates: &[Candidate]) {
+    fn build_groups(&mut self, mut light: Vec<(u32, u32)>, candidates: Candidates<'_>) {
         if light.is_empty() {
             return;
         }

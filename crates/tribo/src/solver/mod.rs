@@ -419,18 +419,6 @@ pub(crate) fn for_each_mut3<A: Send, B: Send, C: Send>(
     }
 }
 
-/// `out` = `f` of every item, in order (split between the worker threads if `parallel`);
-/// reuses `out`'s allocation.
-pub(crate) fn map_into<T: Sync, U: Send>(parallel: bool, items: &[T], out: &mut Vec<U>, f: impl Fn(&T) -> U + Sync) {
-    if parallel {
-        use rayon::prelude::*;
-        items.par_iter().with_min_len(256).map(|x| f(x)).collect_into_vec(out);
-    } else {
-        out.clear();
-        out.extend(items.iter().map(f));
-    }
-}
-
 /// A family of constraints solved by the step (contacts now; joints later). The set is
 /// built before the step's stages run.
 pub(crate) trait ConstraintSet {

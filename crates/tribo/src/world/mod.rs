@@ -19,7 +19,7 @@ pub use query::{QueryFilter, RayResult};
 pub(crate) use ids::Arena;
 
 use crate::collision::broad_phase::{aabb_margin, sweep_free, BroadPhase, MOVING_TREE, STATIC_TREE};
-use crate::collision::contact::Contact;
+use crate::collision::contact::{Contact, NarrowOutcome};
 use crate::dynamics::body::Body;
 use crate::dynamics::shape::ShapeRecord;
 use crate::dynamics::{BodyDef, BodyType, Filter, Material, ShapeDef};
@@ -127,7 +127,15 @@ pub struct World {
     /// The states as the worker threads share them during the substeps (reused).
     pub(crate) shared_states: Vec<crate::solver::SharedState>,
     pub(crate) contact_solver: ContactSolver,
+    /// The solver's input of each contact slot, written by the narrow phase for the
+    /// touching contacts with an awake dynamic side (`solver_contacts` lists them).
     pub(crate) candidates: Vec<Candidate>,
+    /// The narrow phase's verdict on each contact slot it visited this step, and whether
+    /// the contact has a candidate (dense: the serial pass after the narrow phase reads
+    /// these instead of the contact records).
+    pub(crate) outcomes: Vec<(NarrowOutcome, bool)>,
+    /// The touching contacts the solver takes this step, in contact order.
+    pub(crate) solver_contacts: Vec<u32>,
     /// Contacts the narrow phase of the current step listed: those with an awake moving
     /// body, or every contact slot when most bodies are awake (each then tests its bodies).
     pub(crate) active_contacts: Vec<u32>,
@@ -178,6 +186,8 @@ impl World {
             sims: Vec::new(),
             contact_solver: ContactSolver::default(),
             candidates: Vec::new(),
+            outcomes: Vec::new(),
+            solver_contacts: Vec::new(),
             active_contacts: Vec::new(),
             touching_contacts: Vec::new(),
             scratch_u32: Vec::new(),

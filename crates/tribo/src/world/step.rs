@@ -15,9 +15,9 @@ use crate::dynamics::{mix, BodyType};
 use crate::error::{Error, Result};
 use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
-use crate::solver::contact_set::Candidate;
+use crate::solver::contact_set::{Candidate, Candidates};
 use crate::solver::contact_solver::{ConstraintBodies, ContactInput};
-use crate::solver::{for_each_mut, map_into, solve_step, BodySim, BodyState, SharedState, SolverBody, StepContext};
+use crate::solver::{for_each_mut3, solve_step, BodySim, BodyState, SharedState, SolverBody, StepContext};
 use crate::world::Arena;
 use crate::world::BodyId;
 
@@ -52,10 +52,12 @@ impl World {
         let mut lap = Stopwatch::start();
         self.update_pairs();
         self.profile.pairs = lap.lap();
+        self.prepare_bodies();
+        let bodies_ms = lap.lap();
         self.collide(dt, parallel);
         self.profile.collide = lap.lap();
         let ctx = self.step_context(dt, parallel);
-        self.solve(&ctx);
+        self.solve(&ctx, bodies_ms);
         lap.lap();
         self.finalize(dt, parallel);
         self.profile.finalize = lap.lap();
@@ -173,7 +175,6 @@ impl World {
             rolling_impulse: 0.0,
             touching: false,
             basis: Default::default(),
-            outcome: NarrowOutcome::Skipped,
         };
         let (body_a, body_b) = (contact.body_a, contact.body_b);
         let ci = match self.contact_free.pop() {
@@ -196,12 +197,39 @@ impl World {
     }
 
     /// Narrow phase: update the manifold of every contact with an awake moving body (split
-    /// between the worker threads: each contact only writes itself); then, in contact
-    /// order, destroy contacts whose fat boxes separated, report begin/end, wake sleepers.
+    /// between the worker threads: each contact only writes itself, its outcome and its
+    /// solver candidate); then, in contact order, destroy contacts whose fat boxes
+    /// separated, report begin/end, wake sleepers.
+    ///
+    /// The solver's input of each touching contact ([`Candidate`]) is made here, while the
+    /// contact's record is in cache from its update, instead of in a second pass over the
+    /// records (they are several cache lines each; 58 000 of them in many_pyramids). It
+    /// needs the awake bodies' solver entries, made by [`World::prepare_bodies`] before; a
+    /// step that wakes a sleeping island makes them and the candidates again.
     fn collide(&mut self, dt: f32, parallel: bool) {
         let mut active = core::mem::take(&mut self.active_contacts);
         let mut flags = core::mem::take(&mut self.scratch_flags);
-        let (bodies, shapes) = (&self.bodies, &self.shapes);
+        let mut outcomes = core::mem::take(&mut self.outcomes);
+        let mut candidates = core::mem::take(&mut self.candidates);
+        // Slots are written before they are read (every listed contact gets an outcome, a
+        // solvable one its candidate): no clearing.
+        outcomes.resize(self.contacts.len(), (NarrowOutcome::Skipped, false));
+        candidates.resize(self.contacts.len(), Candidate::SKIP);
+        let (bodies, shapes, solver_bodies) = (&self.bodies, &self.shapes, &self.solver_bodies);
+        // Updates one contact, writes its outcome and, if it is touching with an awake
+        // dynamic side, its candidate.
+        let update = |ci: usize, c: &mut Contact, cand: &mut Candidate, out: &mut (NarrowOutcome, bool)| {
+            let outcome = narrow_phase(c, bodies, shapes, dt);
+            let solvable = matches!(outcome, NarrowOutcome::Updated { touching: true, .. })
+                && match candidate(ci as u32, c, solver_bodies) {
+                    Some(x) => {
+                        *cand = x;
+                        true
+                    }
+                    None => false,
+                };
+            *out = (outcome, solvable);
+        };
         if self.active_body_flags(&mut flags) {
             // Mostly awake: each contact tests its two bodies' flags itself, in the parallel
             // pass (no serial pass to list the active contacts first); then every contact
@@ -210,15 +238,17 @@ impl World {
             active.extend(0..self.contacts.len() as u32);
             let flags = &flags;
             let flag = |bi: u32| flags.get(bi as usize).copied().unwrap_or(false);
-            for_each_mut(parallel, &mut self.contacts, CONTACT_CHUNK, |_, slot| {
-                if let Some(c) = slot.as_mut() {
-                    c.outcome = if flag(c.body_a) || flag(c.body_b) {
-                        narrow_phase(c, bodies, shapes, dt)
-                    } else {
-                        NarrowOutcome::Skipped
-                    };
-                }
-            });
+            for_each_mut3(
+                parallel,
+                &mut self.contacts,
+                &mut candidates,
+                &mut outcomes,
+                CONTACT_CHUNK,
+                |ci, slot, cand, out| match slot.as_mut() {
+                    Some(c) if flag(c.body_a) || flag(c.body_b) => update(ci, c, cand, out),
+                    _ => *out = (NarrowOutcome::Skipped, false),
+                },
+            );
         } else {
             self.collect_active_contacts(&mut active, &flags, false, false);
             let mut mark = core::mem::take(&mut self.scratch_mark);
@@ -227,35 +257,53 @@ impl World {
             for &ci in &active {
                 mark[ci as usize] = true;
             }
-            for_each_mut(parallel, &mut self.contacts, CONTACT_CHUNK, |ci, slot| {
-                // The mark first: a sleeping contact's record is not even read.
-                if mark[ci] {
-                    if let Some(c) = slot.as_mut() {
-                        c.outcome = narrow_phase(c, bodies, shapes, dt);
+            for_each_mut3(
+                parallel,
+                &mut self.contacts,
+                &mut candidates,
+                &mut outcomes,
+                CONTACT_CHUNK,
+                |ci, slot, cand, out| {
+                    // The mark first: a sleeping contact's record is not even read.
+                    if mark[ci] {
+                        match slot.as_mut() {
+                            Some(c) => update(ci, c, cand, out),
+                            None => *out = (NarrowOutcome::Skipped, false),
+                        }
                     }
-                }
-            });
+                },
+            );
             self.scratch_mark = mark;
         }
         self.scratch_flags = flags;
         let mut to_destroy = Vec::new();
         let mut to_wake = Vec::new();
         let mut touching = core::mem::take(&mut self.touching_contacts);
+        let mut solvable = core::mem::take(&mut self.solver_contacts);
         touching.clear();
-        // Read only (the outcome of every listed contact was written this step): a serial
-        // pass that wrote each record would make the next parallel pass pull them back.
+        solvable.clear();
+        // Reads the dense outcomes, and a contact's record only when its touching changed.
         for &ci in &active {
-            let Some(c) = self.contacts[ci as usize].as_ref() else {
+            let Some(&(outcome, can_solve)) = outcomes.get(ci as usize) else {
                 continue;
             };
-            match c.outcome {
+            match outcome {
                 NarrowOutcome::Skipped => {}
                 NarrowOutcome::Destroy => to_destroy.push(ci),
                 NarrowOutcome::Updated { touching: now, changed } => {
                     if now {
                         touching.push(ci);
+                        if can_solve {
+                            solvable.push(ci);
+                        }
                     }
-                    if changed && now {
+                    if !changed {
+                        continue;
+                    }
+                    let Some(Some(c)) = self.contacts.get(ci as usize) else {
+                        continue;
+                    };
+                    if now {
                         self.events.begin.push(ContactBeginEvent {
                             shape_a: c.shape_a,
                             shape_b: c.shape_b,
@@ -267,7 +315,7 @@ impl World {
                                 to_wake.push(bi);
                             }
                         }
-                    } else if changed {
+                    } else {
                         self.events.end.push(ContactEndEvent {
                             shape_a: c.shape_a,
                             shape_b: c.shape_b,
@@ -277,7 +325,7 @@ impl World {
             }
         }
         self.active_contacts = active;
-        self.touching_contacts = touching;
+        self.outcomes = outcomes;
         for ci in to_destroy {
             self.destroy_contact(ci, false);
         }
@@ -285,14 +333,29 @@ impl World {
             for bi in to_wake {
                 self.wake_body(bi);
             }
-            // The woken islands' contacts join the solve with their last manifolds.
-            let mut touching = core::mem::take(&mut self.touching_contacts);
+            // The woken islands' bodies get solver entries (every awake body's index can
+            // change) and their contacts join the solve with their last manifolds: the
+            // entries and every touching contact's candidate are made again.
+            self.prepare_bodies();
             let mut flags = core::mem::take(&mut self.scratch_flags);
             let mostly_awake = self.active_body_flags(&mut flags);
             self.collect_active_contacts(&mut touching, &flags, mostly_awake, true);
             self.scratch_flags = flags;
-            self.touching_contacts = touching;
+            solvable.clear();
+            for &ci in &touching {
+                if let Some(Some(c)) = self.contacts.get(ci as usize) {
+                    if let (Some(x), Some(slot)) =
+                        (candidate(ci, c, &self.solver_bodies), candidates.get_mut(ci as usize))
+                    {
+                        *slot = x;
+                        solvable.push(ci);
+                    }
+                }
+            }
         }
+        self.touching_contacts = touching;
+        self.solver_contacts = solvable;
+        self.candidates = candidates;
     }
 
     /// One flag per body slot: awake and not static (read in body order, so the contacts
@@ -350,10 +413,10 @@ impl World {
         out.sort_unstable();
     }
 
-    /// Builds the solver arrays from the awake bodies and touching contacts, runs the
-    /// solver stages and stores impulses back into the contacts.
-    fn solve(&mut self, ctx: &StepContext) {
-        let mut lap = Stopwatch::start();
+    /// The awake bodies' solver states and step data, and one [`SolverBody`] per body slot
+    /// (index 0 of the states: every static body). Made before the narrow phase, which
+    /// makes the solver's candidates from them.
+    fn prepare_bodies(&mut self) {
         let g = self.def.gravity;
         self.states.clear();
         self.sims.clear();
@@ -399,67 +462,19 @@ impl World {
                 body: bi,
             });
         }
-        // Constraints, in contact order (the colouring puts pairs with a static side in the
-        // top colours, so each pass still solves them last, as Box2D's colouring does).
-        let mut candidates = core::mem::take(&mut self.candidates);
-        let solver_bodies = &self.solver_bodies;
-        let contacts = &self.contacts;
-        let candidate = |ci: u32| -> Option<Candidate> {
-            let c = contacts.get(ci as usize)?.as_ref()?;
-            if !c.touching {
-                return None;
-            }
-            let (ba, bb) = (
-                solver_bodies.get(c.body_a as usize)?,
-                solver_bodies.get(c.body_b as usize)?,
-            );
-            if !ba.awake_dynamic && !bb.awake_dynamic {
-                return None;
-            }
-            Some(Candidate::new(
-                ci,
-                ConstraintBodies {
-                    index_a: ba.index,
-                    index_b: bb.index,
-                    inv_mass_a: ba.inv_mass,
-                    inv_i_a: ba.inv_i,
-                    inv_mass_b: bb.inv_mass,
-                    inv_i_b: bb.inv_i,
-                    center_a: ba.center,
-                    center_b: bb.center,
-                },
-                ContactInput::new(c),
-            ))
-        };
-        // No per-step allocation. Threads: written in place, the rare rejects dropped
-        // after. One thread: pushed straight into the list (no temporary to copy).
-        if ctx.parallel {
-            map_into(true, &self.touching_contacts, &mut candidates, |&ci| {
-                candidate(ci).unwrap_or(Candidate::SKIP)
-            });
-            candidates.retain(|c| c.contact != Candidate::SKIP.contact);
-        } else {
-            candidates.clear();
-            let touching = &self.touching_contacts;
-            for (k, &ci) in touching.iter().enumerate() {
-                // The bodies of a contact a few ahead (contacts come in order, bodies not).
-                if let Some(Some(Some(c))) = touching.get(k + PREFETCH_CONTACTS).map(|&a| contacts.get(a as usize)) {
-                    for bi in [c.body_a, c.body_b] {
-                        if let Some(sb) = solver_bodies.get(bi as usize) {
-                            crate::solver::prefetch(sb);
-                        }
-                    }
-                }
-                if let Some(c) = candidate(ci) {
-                    candidates.push(c);
-                }
-            }
-        }
+    }
+
+    /// Builds the solver's constraints from the candidates the narrow phase made, runs the
+    /// solver stages and stores impulses back into the contacts. `bodies_ms`: the time
+    /// [`World::prepare_bodies`] took (part of the solver set-up).
+    fn solve(&mut self, ctx: &StepContext, bodies_ms: f32) {
+        let mut lap = Stopwatch::start();
+        let g = self.def.gravity;
         let mut solver = core::mem::take(&mut self.contact_solver);
         solver.up = (-g).normalize_or_zero();
-        solver.build(ctx, &self.states, &self.sims, &candidates);
-        self.candidates = candidates;
-        self.profile.solver_setup = lap.lap();
+        let candidates = Candidates::new(&self.candidates, &self.solver_contacts);
+        solver.build(ctx, &self.states, &self.sims, candidates);
+        self.profile.solver_setup = bodies_ms + lap.lap();
         if ctx.parallel {
             // Threads share the states (`SharedState`, one per cache line) for the substeps,
             // then copy them back; the shared array is kept from step to step.
@@ -635,13 +650,37 @@ const BODY_CHUNK: usize = 256;
 /// Contacts per parallel chunk of the narrow phase and the impulse store.
 const CONTACT_CHUNK: usize = 256;
 
-/// How many contacts ahead the solver's candidate pass asks for the bodies' `SolverBody`
-/// entries.
-const PREFETCH_CONTACTS: usize = 8;
-
 /// Contact lists up to this long are searched for an existing pair instead of the pair
 /// table (a few keys in one cache line beat a hash probe into a large table).
 const SHORT_CONTACT_LIST: usize = 16;
+
+/// The solver's input of a touching contact with an awake dynamic side (`None` otherwise).
+fn candidate(ci: u32, c: &Contact, solver_bodies: &[SolverBody]) -> Option<Candidate> {
+    if !c.touching {
+        return None;
+    }
+    let (ba, bb) = (
+        solver_bodies.get(c.body_a as usize)?,
+        solver_bodies.get(c.body_b as usize)?,
+    );
+    if !ba.awake_dynamic && !bb.awake_dynamic {
+        return None;
+    }
+    Some(Candidate::new(
+        ci,
+        ConstraintBodies {
+            index_a: ba.index,
+            index_b: bb.index,
+            inv_mass_a: ba.inv_mass,
+            inv_i_a: ba.inv_i,
+            inv_mass_b: bb.inv_mass,
+            inv_i_b: bb.inv_i,
+            center_a: ba.center,
+            center_b: bb.center,
+        },
+        ContactInput::new(c),
+    ))
+}
 
 /// Updates one contact's manifold (recycled when its bodies barely moved); reads only the
 /// bodies and shapes, so contacts can be updated in parallel.
