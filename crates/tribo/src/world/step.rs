@@ -230,51 +230,43 @@ impl World {
                 };
             *out = (outcome, solvable);
         };
-        if self.active_body_flags(&mut flags) {
+        let mostly_awake = self.active_body_flags(&mut flags);
+        let mut mark = core::mem::take(&mut self.scratch_mark);
+        mark.clear();
+        if mostly_awake {
             // Mostly awake: each contact tests its two bodies' flags itself, in the parallel
             // pass (no serial pass to list the active contacts first); then every contact
             // is visited in order below.
             active.clear();
             active.extend(0..self.contacts.len() as u32);
-            let flags = &flags;
-            let flag = |bi: u32| flags.get(bi as usize).copied().unwrap_or(false);
-            for_each_mut3(
-                parallel,
-                &mut self.contacts,
-                &mut candidates,
-                &mut outcomes,
-                CONTACT_CHUNK,
-                |ci, slot, cand, out| match slot.as_mut() {
-                    Some(c) if flag(c.body_a) || flag(c.body_b) => update(ci, c, cand, out),
-                    _ => *out = (NarrowOutcome::Skipped, false),
-                },
-            );
         } else {
+            // Otherwise the active contacts are listed through the awake bodies and marked.
             self.collect_active_contacts(&mut active, &flags, false, false);
-            let mut mark = core::mem::take(&mut self.scratch_mark);
-            mark.clear();
             mark.resize(self.contacts.len(), false);
             for &ci in &active {
                 mark[ci as usize] = true;
             }
-            for_each_mut3(
-                parallel,
-                &mut self.contacts,
-                &mut candidates,
-                &mut outcomes,
-                CONTACT_CHUNK,
-                |ci, slot, cand, out| {
-                    // The mark first: a sleeping contact's record is not even read.
-                    if mark[ci] {
-                        match slot.as_mut() {
-                            Some(c) => update(ci, c, cand, out),
-                            None => *out = (NarrowOutcome::Skipped, false),
-                        }
-                    }
-                },
-            );
-            self.scratch_mark = mark;
         }
+        let (flags_ref, mark_ref) = (&flags, &mark);
+        let flag = |bi: u32| flags_ref.get(bi as usize).copied().unwrap_or(false);
+        for_each_mut3(
+            parallel,
+            &mut self.contacts,
+            &mut candidates,
+            &mut outcomes,
+            CONTACT_CHUNK,
+            |ci, slot, cand, out| {
+                // The mark first: a sleeping contact's record is not even read.
+                if !mostly_awake && !mark_ref[ci] {
+                    return;
+                }
+                match slot.as_mut() {
+                    Some(c) if !mostly_awake || flag(c.body_a) || flag(c.body_b) => update(ci, c, cand, out),
+                    _ => *out = (NarrowOutcome::Skipped, false),
+                }
+            },
+        );
+        self.scratch_mark = mark;
         self.scratch_flags = flags;
         let mut to_destroy = Vec::new();
         let mut to_wake = Vec::new();
