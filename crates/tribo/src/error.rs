@@ -1,7 +1,7 @@
 //! The one error type of the public API.
 
 use crate::geometry::GeometryError;
-use crate::world::{BodyId, ShapeId};
+use crate::world::{BodyId, JointId, ShapeId};
 use core::fmt;
 
 /// Everything that can go wrong in a public call. A call that returns an error changes
@@ -12,6 +12,9 @@ pub enum Error {
     InvalidBody(BodyId),
     /// The shape id is stale (the shape or its body was destroyed) or was never issued.
     InvalidShape(ShapeId),
+    /// The joint id is stale (the joint or one of its bodies was destroyed) or was never
+    /// issued.
+    InvalidJoint(JointId),
     /// An argument is out of range or not finite.
     InvalidArgument {
         /// Which argument or field, e.g. `"BodyDef::position"`.
@@ -44,6 +47,11 @@ impl fmt::Display for Error {
             Error::InvalidShape(id) => write!(
                 f,
                 "shape id (index {}, generation {}) is stale or was never created",
+                id.index, id.generation
+            ),
+            Error::InvalidJoint(id) => write!(
+                f,
+                "joint id (index {}, generation {}) is stale or was never created",
                 id.index, id.generation
             ),
             Error::InvalidArgument { name, reason } => write!(f, "{name}: {reason}"),

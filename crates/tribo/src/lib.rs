@@ -27,7 +27,8 @@
 //! - [`math`]: vectors, rotations, transforms, boxes.
 //! - [`geometry`]: pure shapes, hull, mass, ray casts, contact manifolds.
 //! - `collision`: dynamic AABB trees, broad phase, contact records (internal).
-//! - `dynamics`: bodies, shapes, [`Material`] and [`CombineRule`].
+//! - `dynamics`: bodies, shapes, [`Material`] and [`CombineRule`], joints
+//!   ([`RevoluteJointDef`]).
 //! - `solver`: the soft step and the contact constraint with stick/slip friction
 //!   (internal; its design is documented in `ARCHITECTURE.md`).
 //! - [`World`]: creation, the step, events, queries.
@@ -54,11 +55,11 @@ mod solver;
 mod world;
 
 pub use collision::FrictionState;
-pub use dynamics::{mix, BodyDef, BodyType, CombineRule, Filter, Material, MixedMaterial, ShapeDef};
+pub use dynamics::{mix, BodyDef, BodyType, CombineRule, Filter, Material, MixedMaterial, RevoluteJointDef, ShapeDef};
 pub use error::{Error, Result};
 pub use geometry::{Capsule, Circle, GeometryError, MassData, Polygon, Segment, Shape};
 pub use math::{Aabb, Rot, Transform, Vec2};
 pub use world::{
-    BodyId, ContactBeginEvent, ContactEndEvent, ContactEvents, ContactInfo, ContactPointInfo, Profile, QueryFilter,
-    RayResult, ShapeId, World, WorldDef,
+    BodyId, ContactBeginEvent, ContactEndEvent, ContactEvents, ContactInfo, ContactPointInfo, JointId, Profile,
+    QueryFilter, RayResult, ShapeId, World, WorldDef,
 };

@@ -163,6 +163,8 @@ pub(crate) struct Body {
     /// The shape-pair key of each of `contacts` (same order): the broad phase checks a
     /// body's short list before the world's pair table.
     pub contact_keys: Vec<u64>,
+    /// Slot indices of the joints attached to this body.
+    pub joints: Vec<u32>,
     pub user_data: u64,
     /// Sleeping island this body belongs to while asleep (index into the world's list).
     pub sleep_island: u32,
@@ -201,6 +203,7 @@ impl Body {
             shapes: Vec::new(),
             contacts: Vec::new(),
             contact_keys: Vec::new(),
+            joints: Vec::new(),
             user_data: def.user_data,
             sleep_island: u32::MAX,
         }

@@ -15,12 +15,14 @@
 //! 3. restitution (one pass, from the recorded impact velocities)
 //! 4. store impulses and friction states back into the contacts
 //!
-//! Constraints join the solver through [`ConstraintSet`]; contacts are the one set today,
-//! joints will be another.
+//! Constraints join the solver through [`ConstraintSet`]: [`StepConstraints`] holds the
+//! step's joints ([`joint_solver`], solved one at a time first in each pass) and contacts
+//! ([`contact_set`], coloured and wide).
 
 pub(crate) mod contact_set;
 pub(crate) mod contact_solver;
 pub(crate) mod contact_wide;
+pub(crate) mod joint_solver;
 pub(crate) mod softness;
 pub(crate) mod wide;
 
@@ -449,6 +451,46 @@ pub(crate) trait ConstraintSet {
         _times: &mut [f32; 5],
     ) -> bool {
         false
+    }
+}
+
+/// The constraints of a step: joints, then contacts, in every pass.
+pub(crate) struct StepConstraints<'a> {
+    pub joints: &'a mut joint_solver::JointSolver,
+    pub contacts: &'a mut contact_set::ContactSolver,
+}
+
+impl ConstraintSet for StepConstraints<'_> {
+    fn has_new_contacts(&self) -> bool {
+        self.contacts.has_new_contacts()
+    }
+    fn estimate_new_contacts<C: StateCell>(&mut self, ctx: &StepContext, trial: &[C]) -> bool {
+        self.contacts.estimate_new_contacts(ctx, trial)
+    }
+    fn warm_start<C: StateCell>(&mut self, ctx: &StepContext, states: &[C]) {
+        self.joints.warm_start(states);
+        self.contacts.warm_start(ctx, states);
+    }
+    fn solve<C: StateCell>(&mut self, ctx: &StepContext, states: &[C], use_bias: bool, elapsed: f32) {
+        self.joints.solve(states, ctx, use_bias);
+        self.contacts.solve(ctx, states, use_bias, elapsed);
+    }
+    fn end_substep(&mut self) {
+        self.contacts.end_substep();
+    }
+    fn restitution<C: StateCell>(&mut self, states: &[C]) {
+        self.contacts.restitution(states);
+    }
+    fn substeps_team(
+        &mut self,
+        ctx: &StepContext,
+        sims: &[BodySim],
+        states: &[SharedState],
+        times: &mut [f32; 5],
+    ) -> bool {
+        // The team solves colours only; joints run on one thread before each pass's
+        // colours, which the per-colour path does.
+        self.joints.constraints.is_empty() && self.contacts.substeps_team(ctx, sims, states, times)
     }
 }
 

@@ -21,6 +21,15 @@ pub struct ShapeId {
     pub generation: u32,
 }
 
+/// Handle to a joint. Stale handles are detected (see [`crate::Error::InvalidJoint`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct JointId {
+    /// Slot index.
+    pub index: u32,
+    /// Slot generation when the id was issued.
+    pub generation: u32,
+}
+
 #[derive(Clone, Debug)]
 struct Slot<T> {
     generation: u32,

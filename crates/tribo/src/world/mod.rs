@@ -6,12 +6,13 @@
 
 mod events;
 mod ids;
+mod joints;
 mod profile;
 mod query;
 mod step;
 
 pub use events::{ContactBeginEvent, ContactEndEvent, ContactEvents, ContactInfo, ContactPointInfo};
-pub use ids::{BodyId, ShapeId};
+pub use ids::{BodyId, JointId, ShapeId};
 pub use profile::Profile;
 pub(crate) use profile::Stopwatch;
 pub use query::{QueryFilter, RayResult};
@@ -114,6 +115,7 @@ pub struct World {
     pub(crate) shapes: Arena<ShapeRecord>,
     pub(crate) contacts: Vec<Option<Contact>>,
     pub(crate) contact_free: Vec<u32>,
+    pub(crate) joints: Arena<crate::dynamics::joint::JointRecord>,
     pub(crate) broad_phase: BroadPhase,
     pub(crate) events: ContactEvents,
     /// Bodies of each sleeping island (slot = island id); `None` = free slot.
@@ -127,6 +129,7 @@ pub struct World {
     /// The states as the worker threads share them during the substeps (reused).
     pub(crate) shared_states: Vec<crate::solver::SharedState>,
     pub(crate) contact_solver: ContactSolver,
+    pub(crate) joint_solver: crate::solver::joint_solver::JointSolver,
     /// The solver's input of each contact slot, written by the narrow phase for the
     /// touching contacts with an awake dynamic side (`solver_contacts` lists them).
     pub(crate) candidates: Vec<Candidate>,
@@ -177,6 +180,7 @@ impl World {
             shapes: Arena::default(),
             contacts: Vec::new(),
             contact_free: Vec::new(),
+            joints: Arena::default(),
             broad_phase: BroadPhase::default(),
             events: ContactEvents::default(),
             sleep_islands: Vec::new(),
@@ -185,6 +189,7 @@ impl World {
             states: Vec::new(),
             sims: Vec::new(),
             contact_solver: ContactSolver::default(),
+            joint_solver: Default::default(),
             candidates: Vec::new(),
             outcomes: Vec::new(),
             solver_contacts: Vec::new(),
@@ -287,10 +292,15 @@ impl World {
         Ok(id)
     }
 
-    /// Destroys a body, its shapes and its contacts (end-touch events are reported).
+    /// Destroys a body, its shapes, its contacts (end-touch events are reported) and its
+    /// joints.
     pub fn destroy_body(&mut self, id: BodyId) -> Result<()> {
-        let shapes = self.body_ref(id)?.shapes.clone();
+        let b = self.body_ref(id)?;
+        let (shapes, joints) = (b.shapes.clone(), b.joints.clone());
         self.wake_body(id.index);
+        for j in joints {
+            self.remove_joint_internal(j);
+        }
         for s in shapes {
             self.remove_shape_internal(s);
         }
@@ -870,13 +880,23 @@ impl World {
         self.sleep_islands[island as usize] = Some(members.to_vec());
     }
 
-    /// The awake dynamic bodies connected to `body_index` through touching contacts.
+    /// The awake dynamic bodies connected to `body_index` through touching contacts and
+    /// joints.
     fn island_of(&self, body_index: u32) -> Vec<u32> {
         let mut out = vec![body_index];
         let mut seen = std::collections::BTreeSet::from([body_index]);
         let mut i = 0;
         while i < out.len() {
             if let Some(b) = self.bodies.at(out[i]) {
+                for &ji in &b.joints {
+                    if let Some(j) = self.joints.at(ji) {
+                        let other = if j.body_a == out[i] { j.body_b } else { j.body_a };
+                        let dynamic = self.bodies.at(other).is_some_and(|o| o.is_dynamic());
+                        if dynamic && seen.insert(other) {
+                            out.push(other);
+                        }
+                    }
+                }
                 for &ci in &b.contacts {
                     if let Some(Some(c)) = self.contacts.get(ci as usize) {
                         if !c.touching {

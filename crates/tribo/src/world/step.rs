@@ -17,7 +17,9 @@ use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::{Candidate, Candidates};
 use crate::solver::contact_solver::{ConstraintBodies, ContactInput};
-use crate::solver::{for_each_mut3, solve_step, BodySim, BodyState, SharedState, SolverBody, StepContext};
+use crate::solver::{
+    for_each_mut3, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints, StepContext,
+};
 use crate::world::Arena;
 use crate::world::BodyId;
 
@@ -132,7 +134,8 @@ impl World {
                     if (o.moved && other < si) || o.body == s.body || !s.filter.should_collide(&o.filter) {
                         return true;
                     }
-                    if body.is_dynamic() || self.bodies.at(o.body.index).is_some_and(|b| b.is_dynamic()) {
+                    let dynamic = body.is_dynamic() || self.bodies.at(o.body.index).is_some_and(|b| b.is_dynamic());
+                    if dynamic && (body.joints.is_empty() || !self.joint_blocks_pair(s.body.index, o.body.index)) {
                         new_pairs.push(pair_key(si, other));
                     }
                     true
@@ -466,25 +469,33 @@ impl World {
         solver.up = (-g).normalize_or_zero();
         let candidates = Candidates::new(&self.candidates, &self.solver_contacts);
         solver.build(ctx, &self.states, &self.sims, candidates);
+        self.build_joints(ctx);
         self.profile.solver_setup = bodies_ms + lap.lap();
+        let mut joints = core::mem::take(&mut self.joint_solver);
+        let mut set = StepConstraints {
+            joints: &mut joints,
+            contacts: &mut solver,
+        };
         if ctx.parallel {
             // Threads share the states (`SharedState`, one per cache line) for the substeps,
             // then copy them back; the shared array is kept from step to step.
             let mut shared = core::mem::take(&mut self.shared_states);
             shared.clear();
             shared.extend(self.states.iter().map(|&s| SharedState::new(s)));
-            solve_step(ctx, &self.sims, &shared, &mut solver, &mut self.profile);
+            solve_step(ctx, &self.sims, &shared, &mut set, &mut self.profile);
             for (s, x) in self.states.iter_mut().zip(&shared) {
                 *s = x.load();
             }
             self.shared_states = shared;
         } else {
             let cells = core::cell::Cell::from_mut(&mut self.states[..]).as_slice_of_cells();
-            solve_step(ctx, &self.sims, cells, &mut solver, &mut self.profile);
+            solve_step(ctx, &self.sims, cells, &mut set, &mut self.profile);
         }
         lap.lap();
         solver.store(ctx, &self.states, &mut self.contacts);
         self.contact_solver = solver;
+        self.joint_solver = joints;
+        self.store_joints(ctx);
         self.profile.store = lap.lap();
     }
 
@@ -580,18 +591,20 @@ impl World {
             }
             x
         }
-        for &ci in &self.touching_contacts {
-            let Some(Some(c)) = self.contacts.get(ci as usize) else {
-                continue;
-            };
-            if !c.touching {
-                continue;
-            }
-            let (Some(a), Some(b)) = (self.bodies.at(c.body_a), self.bodies.at(c.body_b)) else {
+        // Touching contacts and joints link awake dynamic bodies into islands.
+        let links = self
+            .touching_contacts
+            .iter()
+            .filter_map(|&ci| self.contacts.get(ci as usize)?.as_ref())
+            .filter(|c| c.touching)
+            .map(|c| (c.body_a, c.body_b))
+            .chain(self.joints.iter().map(|(_, j)| (j.body_a, j.body_b)));
+        for (ia, ib) in links {
+            let (Some(a), Some(b)) = (self.bodies.at(ia), self.bodies.at(ib)) else {
                 continue;
             };
             if a.is_dynamic() && b.is_dynamic() && a.awake && b.awake {
-                let (ra, rb) = (find(&mut parent, c.body_a), find(&mut parent, c.body_b));
+                let (ra, rb) = (find(&mut parent, ia), find(&mut parent, ib));
                 if ra != rb {
                     // Union by smaller index: deterministic roots.
                     let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
