@@ -278,7 +278,8 @@ impl DynamicTree {
     }
 
     /// [`move_proxy`](Self::move_proxy) for a proxy that moved a little: while the new box
-    /// still overlaps its sibling's box (the leaf is still among its neighbours), the leaf
+    /// is within half its size of its sibling's box (the leaf is still among its
+    /// neighbours), the leaf
     /// keeps its place and its ancestors are refitted exactly on the way up (stopping at
     /// the first unchanged one): no removal, no SAH search, no rotations, and the boxes stay
     /// tight. A proxy that left its neighbourhood is reinserted. Returns false when `proxy`
@@ -294,7 +295,13 @@ impl DynamicTree {
         }
         let p = &self.nodes[parent as usize];
         let sibling = if p.child1 == proxy { p.child2 } else { p.child1 };
-        if !aabb.overlaps(self.nodes[sibling as usize].aabb) {
+        // Near: within half the proxy's own size of its sibling's box. Neighbours of a
+        // sparse lattice (Box2D's joint grid: circles 0.8 m wide, 1 m apart) do not overlap
+        // but are still each other's best siblings; a proxy flying off (smash) leaves this
+        // range within a step or two. The range is bounded by the sibling's box, so a leaf
+        // cannot creep away while it keeps its place.
+        let reach = 0.5 * (aabb.max - aabb.min).x.max((aabb.max - aabb.min).y);
+        if !aabb.overlaps(self.nodes[sibling as usize].aabb.expand(reach)) {
             return self.move_proxy(proxy, aabb);
         }
         self.nodes[proxy as usize].aabb = aabb;
