@@ -55,6 +55,7 @@ mod solver;
 mod world;
 
 pub use collision::FrictionState;
+pub use dynamics::joint::{DEFAULT_CONSTRAINT_DAMPING_RATIO, DEFAULT_CONSTRAINT_HERTZ};
 pub use dynamics::{mix, BodyDef, BodyType, CombineRule, Filter, Material, MixedMaterial, RevoluteJointDef, ShapeDef};
 pub use error::{Error, Result};
 pub use geometry::{Capsule, Circle, GeometryError, MassData, Polygon, Segment, Shape};

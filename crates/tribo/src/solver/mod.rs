@@ -338,6 +338,9 @@ pub(crate) struct BodySim {
     pub angular_damping: f32,
     /// Body slot index in the world.
     pub body: u32,
+    /// The body has joints (a motor may drive it with any torque: its contacts get no
+    /// mass-ratio sweeps, see `contact_set`).
+    pub jointed: bool,
 }
 
 /// What the constraint build needs of a body, one per body slot (static and sleeping

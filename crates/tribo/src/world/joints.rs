@@ -25,16 +25,12 @@ impl RevoluteJointDef {
 
 impl World {
     /// Creates a revolute joint; wakes both bodies and, unless `collide_connected`, ends
-    /// the contacts between them. At least one body must be dynamic.
+    /// the contacts between them. A joint between two bodies that are not dynamic is
+    /// allowed and does nothing (Box2D's joint grid links its static anchors too).
     pub fn create_revolute_joint(&mut self, def: &RevoluteJointDef) -> Result<JointId> {
         def.validate()?;
-        let (a, b) = (self.body_ref(def.body_a)?, self.body_ref(def.body_b)?);
-        if !a.is_dynamic() && !b.is_dynamic() {
-            return Err(Error::arg(
-                "RevoluteJointDef::body_b",
-                "a joint needs at least one dynamic body (both are static or kinematic)",
-            ));
-        }
+        self.body_ref(def.body_a)?;
+        self.body_ref(def.body_b)?;
         let record = JointRecord {
             def: *def,
             body_a: def.body_a.index,

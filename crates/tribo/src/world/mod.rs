@@ -806,7 +806,11 @@ impl World {
     pub(crate) fn refresh_body_proxies(&mut self, body_index: u32, dt: f32) {
         // Disjoint field borrows: no copy of the shape list in this per-step path.
         let Some(b) = self.bodies.at(body_index) else { return };
-        let (xf, v) = (b.xf, b.v);
+        // The solver never moves a body faster than the world's speed limit; a velocity
+        // above it (left by the last pass of a violent step) must not sweep a box across
+        // the world, which would pair it with every shape.
+        let (xf, speed, limit) = (b.xf, b.v.length(), self.def.max_linear_speed);
+        let v = if speed > limit { b.v * (limit / speed) } else { b.v };
         for &sid in &b.shapes {
             let Some(s) = self.shapes.get_mut(sid.index, sid.generation) else {
                 continue;

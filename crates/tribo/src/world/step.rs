@@ -455,6 +455,7 @@ impl World {
                 linear_damping: if dynamic { b.linear_damping } else { 0.0 },
                 angular_damping: if dynamic { b.angular_damping } else { 0.0 },
                 body: bi,
+                jointed: !b.joints.is_empty(),
             });
         }
     }
