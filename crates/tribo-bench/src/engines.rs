@@ -10,7 +10,7 @@
 //! what differs in Rapier).
 
 use std::error::Error;
-use tribo_scenes::format::{BodyKind, SceneFile, ShapeSpec};
+use tribo_scenes::format::{BodyKind, JointSpec, SceneFile, ShapeSpec};
 
 /// Errors from any engine.
 pub type BoxError = Box<dyn Error>;
@@ -83,6 +83,8 @@ pub trait Sim {
     fn angle(&mut self, i: usize) -> f32;
     /// Centre-of-mass velocity of scene body `i`.
     fn velocity(&mut self, i: usize) -> [f32; 2];
+    /// Angular velocity [rad/s] of scene body `i`.
+    fn angular_velocity(&mut self, i: usize) -> f32;
     /// Mass of scene body `i` (0 for static bodies).
     fn mass(&mut self, i: usize) -> f32;
     /// The engine's own contact (pair) count; definitions differ between engines.
@@ -114,6 +116,35 @@ pub fn build(kind: EngineKind, scene: &SceneFile, threads: usize) -> Result<Box<
 
 fn shape_field<T: Copy>(v: Option<T>, what: &str, s: &ShapeSpec) -> Result<T, BoxError> {
     v.ok_or_else(|| format!("a {} shape needs \"{what}\"", s.kind).into())
+}
+
+/// A scene joint as the peers build it: body indices, the anchor in each body's frame
+/// (relative to the body origin) [m], and B's initial rotation relative to A [rad] (the
+/// joint angle is 0 there).
+struct JointGeometry {
+    a: usize,
+    b: usize,
+    local_a: [f32; 2],
+    local_b: [f32; 2],
+    relative_angle: f32,
+}
+
+fn joint_geometry(scene: &SceneFile, j: &JointSpec) -> Result<JointGeometry, BoxError> {
+    let a = scene.resolve_body("joint.body_a", &j.body_a).map_err(|e| e.1)?;
+    let b = scene.resolve_body("joint.body_b", &j.body_b).map_err(|e| e.1)?;
+    let local = |i: usize| {
+        let body = &scene.bodies[i];
+        let (s, c) = body.angle.sin_cos();
+        let d = [j.anchor[0] - body.position[0], j.anchor[1] - body.position[1]];
+        [c * d[0] + s * d[1], -s * d[0] + c * d[1]]
+    };
+    Ok(JointGeometry {
+        a,
+        b,
+        local_a: local(a),
+        local_b: local(b),
+        relative_angle: scene.bodies[b].angle - scene.bodies[a].angle,
+    })
 }
 
 // ---------------------------------------------------------------------------------------
@@ -180,6 +211,9 @@ mod tribo_sim {
                 .map(arr)
                 .unwrap_or([f32::NAN; 2])
         }
+        fn angular_velocity(&mut self, i: usize) -> f32 {
+            self.world.body_angular_velocity(self.bodies[i]).unwrap_or(f32::NAN)
+        }
         fn mass(&mut self, i: usize) -> f32 {
             self.world.body_mass(self.bodies[i]).unwrap_or(0.0)
         }
@@ -236,8 +270,8 @@ mod tribo_sim {
 mod box2d_sim {
     use super::*;
     use boxdd::{
-        shapes, BodyBuilder, BodyId, BodyType, Foundation, MotionLocks, Position, Profile, ShapeDef, SurfaceMaterial,
-        Transform, Vec2, WorkerCount, World, WorldBuilder,
+        shapes, BodyBuilder, BodyId, BodyType, ConstraintTuning, Filter, Foundation, MotionLocks, Position, Profile,
+        RevoluteJointDef, ShapeDef, SurfaceMaterial, Transform, Vec2, WorkerCount, World, WorldBuilder,
     };
 
     pub struct Box2dSim {
@@ -296,7 +330,17 @@ mod box2d_sim {
                             .with_restitution(m.restitution)?
                             .with_rolling_resistance(m.rolling_resistance)?
                             .with_tangent_speed(m.tangent_speed)?;
-                        let def = ShapeDef::builder().material(material).density(m.density).build()?;
+                        let f = s.filter.map(tribo::Filter::from).unwrap_or_default();
+                        let filter = Filter {
+                            category_bits: f.category,
+                            mask_bits: f.mask,
+                            group_index: f.group,
+                        };
+                        let def = ShapeDef::builder()
+                            .material(material)
+                            .density(m.density)
+                            .filter(filter)
+                            .build()?;
                         match s.kind.as_str() {
                             "circle" => {
                                 let c = s.center.unwrap_or([0.0, 0.0]);
@@ -339,6 +383,30 @@ mod box2d_sim {
                     forces.push((id, v(b.force), b.torque));
                 }
                 bodies.push(id);
+            }
+            for j in &scene.joints {
+                let g = joint_geometry(scene, j)?;
+                // Box2D's joint angle is that of frame B relative to frame A: frame B turned by
+                // −(initial relative angle) makes it 0 at the initial poses, as in the scene.
+                let base = world
+                    .joint_base(bodies[g.a], bodies[g.b])?
+                    .with_local_frame_components(v(g.local_a), 0.0, v(g.local_b), -g.relative_angle)?
+                    .with_collide_connected(j.collide_connected)
+                    .with_constraint_tuning(ConstraintTuning::new(j.constraint_hertz, j.constraint_damping_ratio)?);
+                let mut def = RevoluteJointDef::new(base);
+                if let Some([lower, upper]) = j.limit {
+                    def = def.enable_limit(true).lower_angle(lower).upper_angle(upper);
+                }
+                if let Some(m) = j.motor {
+                    def = def
+                        .enable_motor(true)
+                        .motor_speed(m.speed)
+                        .max_motor_torque(m.max_torque);
+                }
+                if let Some(sp) = j.spring {
+                    def = def.enable_spring(true).hertz(sp.hertz).damping_ratio(sp.damping_ratio);
+                }
+                world.create_revolute_joint(&def)?;
             }
             Ok(Box2dSim {
                 world,
@@ -410,6 +478,12 @@ mod box2d_sim {
                 Err(_) => [f32::NAN; 2],
             }
         }
+        fn angular_velocity(&mut self, i: usize) -> f32 {
+            self.world
+                .body(self.bodies[i])
+                .and_then(|b| b.angular_velocity())
+                .unwrap_or(f32::NAN)
+        }
         fn mass(&mut self, i: usize) -> f32 {
             self.world.body(self.bodies[i]).and_then(|b| b.mass()).unwrap_or(0.0)
         }
@@ -446,6 +520,27 @@ mod rapier_sim {
 
     fn v(a: [f32; 2]) -> Vector {
         Vector::new(a[0], a[1])
+    }
+
+    /// Damping gain of a Rapier velocity motor [N·m·s/rad]: large, so the drive is as
+    /// stiff as Box2D's rigid motor row; the torque bound still limits it.
+    const MOTOR_GAIN: f32 = 1.0e9;
+
+    /// A shape's filter as Rapier's interaction groups (32 bits; Rapier has no group
+    /// index, so only group 0 maps).
+    fn groups(s: &ShapeSpec) -> Result<InteractionGroups, BoxError> {
+        let f = s.filter.map(tribo::Filter::from).unwrap_or_default();
+        if f.group != 0 {
+            return Err("rapier: filter groups are not mapped (Rapier has no group index)".into());
+        }
+        if f.category > u32::MAX as u64 {
+            return Err("rapier: filter categories above bit 31 are not mapped".into());
+        }
+        Ok(InteractionGroups::new(
+            Group::from_bits_truncate(f.category as u32),
+            Group::from_bits_truncate(f.mask as u32),
+            InteractionTestMode::And,
+        ))
     }
 
     impl RapierSim {
@@ -529,6 +624,7 @@ mod rapier_sim {
                         ),
                         other => return Err(format!("unknown shape type {other}").into()),
                     }
+                    .collision_groups(groups(s)?)
                     .density(m.density)
                     .friction(m.friction_static)
                     .friction_combine_rule(CoefficientCombineRule::GeometricMean)
@@ -543,6 +639,39 @@ mod rapier_sim {
                     rb.add_torque(b.torque, false);
                 }
                 bodies.push(handle);
+            }
+            for j in &scene.joints {
+                let g = joint_geometry(scene, j)?;
+                if g.relative_angle != 0.0 && j.limit.is_some() {
+                    return Err(
+                        "rapier: a limited joint between bodies at different initial angles is not mapped".into(),
+                    );
+                }
+                if j.spring.is_some() {
+                    return Err(
+                        "rapier: joint springs are not mapped (Rapier's motor is either a spring or a velocity drive)"
+                            .into(),
+                    );
+                }
+                let mut joint = RevoluteJointBuilder::new()
+                    .local_anchor1(v(g.local_a))
+                    .local_anchor2(v(g.local_b))
+                    .contacts_enabled(j.collide_connected)
+                    .softness(SpringCoefficients::new(j.constraint_hertz, j.constraint_damping_ratio));
+                if let Some([lower, upper]) = j.limit {
+                    joint = joint.limits([lower, upper]);
+                }
+                if let Some(m) = j.motor {
+                    // A velocity drive (no stiffness, damping gain MOTOR_GAIN: near rigid) with
+                    // the torque bound, as Box2D's motor.
+                    joint = joint
+                        .motor_model(MotorModel::ForceBased)
+                        .motor_velocity(m.speed, MOTOR_GAIN)
+                        .motor_max_force(m.max_torque);
+                }
+                world
+                    .impulse_joints
+                    .insert(bodies[g.a], bodies[g.b], joint.build(), true);
             }
             // Bodies created asleep. Rapier wakes bodies whose contacts start touching, and
             // its sleep test compares each body's pose with the pose of its previous step
@@ -599,6 +728,9 @@ mod rapier_sim {
         fn velocity(&mut self, i: usize) -> [f32; 2] {
             let l = self.world.bodies[self.bodies[i]].linvel();
             [l.x, l.y]
+        }
+        fn angular_velocity(&mut self, i: usize) -> f32 {
+            self.world.bodies[self.bodies[i]].angvel()
         }
         fn mass(&mut self, i: usize) -> f32 {
             let rb = &self.world.bodies[self.bodies[i]];

@@ -28,8 +28,9 @@ use tribo_scenes::format::{BodyKind, SceneFile};
     about = "Tribo vs Box2D v3 vs Rapier on Box2D's benchmark scenes"
 )]
 struct Args {
-    /// Scene to run: large_pyramid, many_pyramids, smash, tumbler, or all (these four);
-    /// `scaling` runs the scaling scenes of `--sizes` instead; `scaling_rain_<n>` runs one.
+    /// Scene to run: large_pyramid, many_pyramids, smash, tumbler, compounds, junkyard,
+    /// joint_grid, spinner, washer, or all (these nine); `scaling` runs the scaling scenes
+    /// of `--sizes` instead; `scaling_rain_<n>` runs one.
     #[arg(default_value = "all", value_name = "SCENE")]
     scene_pos: String,
     /// Same as the positional SCENE (overrides it).
@@ -492,17 +493,14 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
             }
         }
         CheckKind::Tumbler => {
-            let drum = scene
-                .bodies
-                .iter()
-                .position(|b| b.kind == BodyKind::Kinematic)
-                .unwrap_or(0);
+            let drum = named_body(scene, "drum");
             let c = scene.bodies[drum].position;
             let (measured, expected, angle_err) = kinematic_angle(scene, sim, drum);
             let (s, co) = expected.sin_cos();
             let limit = 9.5f32;
             let (mut outside, mut max_abs) = (0usize, 0.0f32);
-            for &i in &dynamic {
+            let boxes: Vec<usize> = dynamic.iter().copied().filter(|&i| i != drum).collect();
+            for &i in &boxes {
                 let p = sim.position(i);
                 let d = [p[0] - c[0], p[1] - c[1]];
                 // Into the drum's frame: rotate by −angle.
@@ -521,12 +519,57 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
                 text: format!(
                     "{outside} of {} boxes outside the drum (|x|,|y| < {limit} m in its frame; max {max_abs:.3} m); \
                      drum angle {measured:.4} rad vs ω t = {expected:.4} ≡ {:.4} rad (err {angle_err:.1e})",
-                    dynamic.len(),
+                    boxes.len(),
                     measured - angle_err
                 ),
-                json: json!({"boxes_outside": outside, "boxes": dynamic.len(), "max_local_abs_m": max_abs,
+                json: json!({"boxes_outside": outside, "boxes": boxes.len(), "max_local_abs_m": max_abs,
                              "limit_m": limit, "drum_angle_rad": measured, "drum_angle_expected_rad": expected,
                              "finite": finite}),
+            }
+        }
+        CheckKind::JointGrid { max_link } => {
+            let mut longest = 0.0f32;
+            for j in &scene.joints {
+                let (Ok(a), Ok(b)) = (scene.resolve_body("", &j.body_a), scene.resolve_body("", &j.body_b)) else {
+                    continue;
+                };
+                let (pa, pb) = (sim.position(a), sim.position(b));
+                let d = ((pb[0] - pa[0]).powi(2) + (pb[1] - pa[1]).powi(2)).sqrt();
+                longest = if d.is_nan() { f32::NAN } else { longest.max(d) };
+            }
+            let lowest = dynamic
+                .iter()
+                .map(|&i| sim.position(i)[1])
+                .fold(f32::INFINITY, f32::min);
+            let passed = finite && longest < max_link;
+            Check {
+                passed,
+                text: format!(
+                    "longest link {longest:.3} m (< {max_link}; rest length 1 m) over {} joints; lowest body at \
+                     y {lowest:.2} m; speed at the end: max {max_speed:.3}, mean {mean_speed:.4} m/s",
+                    scene.joints.len()
+                ),
+                json: json!({"longest_link_m": longest, "limit_m": max_link, "lowest_y_m": lowest,
+                             "end_max_speed_m_s": max_speed, "end_mean_speed_m_s": mean_speed, "finite": finite}),
+            }
+        }
+        CheckKind::Spinner { radius } => {
+            let rotor = named_body(scene, "rotor");
+            let c = tribo_scenes::scenes::SPINNER_CENTER;
+            let bodies: Vec<usize> = dynamic.iter().copied().filter(|&i| i != rotor).collect();
+            let (outside, max_r) = outside_circle(sim, &bodies, c, radius);
+            let target = tribo_scenes::scenes::SPINNER_MOTOR_SPEED;
+            let w = sim.angular_velocity(rotor);
+            let passed = finite && outside == 0 && (w - target).abs() < 0.01 * target;
+            Check {
+                passed,
+                text: format!(
+                    "{outside} of {} bodies outside the ring (r < {radius} m; max {max_r:.3} m); rotor at \
+                     {w:.4} rad/s (motor {target} rad/s, within 1 %)",
+                    dynamic.len() - 1
+                ),
+                json: json!({"bodies_outside": outside, "max_radius_m": max_r, "limit_m": radius,
+                             "rotor_speed_rad_s": w, "motor_speed_rad_s": target, "finite": finite}),
             }
         }
         CheckKind::Washer { radius } => {
@@ -542,17 +585,7 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
                 r.position[1] + r.linear_velocity[1] * t,
             ];
             let (measured, expected, angle_err) = kinematic_angle(scene, sim, ring);
-            let (mut outside, mut max_r) = (0usize, 0.0f32);
-            for &i in &dynamic {
-                let p = sim.position(i);
-                let d = ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2)).sqrt();
-                if d.is_nan() || d >= radius {
-                    outside += 1;
-                }
-                if d.is_finite() {
-                    max_r = max_r.max(d);
-                }
-            }
+            let (outside, max_r) = outside_circle(sim, &dynamic, c, radius);
             let passed = finite && outside == 0 && angle_err.abs() < 0.01;
             Check {
                 passed,
@@ -603,11 +636,50 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
     }
 }
 
-/// A kinematic body's angle after the run: (the engine's, ω t from the scene, their
-/// difference wrapped to (−π, π]).
+/// How many of `bodies` have their centre at `radius` [m] or more from `c` (or not
+/// finite), and the largest finite distance [m].
+fn outside_circle(sim: &mut dyn Sim, bodies: &[usize], c: [f32; 2], radius: f32) -> (usize, f32) {
+    let (mut outside, mut max_r) = (0usize, 0.0f32);
+    for &i in bodies {
+        let p = sim.position(i);
+        let d = ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2)).sqrt();
+        if d.is_nan() || d >= radius {
+            outside += 1;
+        }
+        if d.is_finite() {
+            max_r = max_r.max(d);
+        }
+    }
+    (outside, max_r)
+}
+
+/// The index of the body with this name (0 if none).
+fn named_body(scene: &SceneFile, name: &str) -> usize {
+    scene
+        .bodies
+        .iter()
+        .position(|b| b.name.as_deref() == Some(name))
+        .unwrap_or(0)
+}
+
+/// A driven body's angle after the run: (the engine's, ω t from the scene, their
+/// difference wrapped to (−π, π]). ω is the body's own angular velocity for a kinematic
+/// body, or the speed of the motor of a joint that holds it to a static body.
 fn kinematic_angle(scene: &SceneFile, sim: &mut dyn Sim, body: usize) -> (f32, f32, f32) {
     let b = &scene.bodies[body];
-    let expected = b.angle + b.angular_velocity * scene.steps as f32 * scene.dt;
+    let motor = scene.joints.iter().find_map(|j| {
+        let (a, bb) = (
+            scene.resolve_body("", &j.body_a).ok()?,
+            scene.resolve_body("", &j.body_b).ok()?,
+        );
+        if bb == body && scene.bodies[a].kind == BodyKind::Static {
+            j.motor.map(|m| m.speed)
+        } else {
+            None
+        }
+    });
+    let omega = motor.unwrap_or(b.angular_velocity);
+    let expected = b.angle + omega * scene.steps as f32 * scene.dt;
     let measured = sim.angle(body);
     let pi = std::f32::consts::PI;
     let err = (measured - expected + pi).rem_euclid(std::f32::consts::TAU) - pi;

@@ -1,8 +1,7 @@
 //! The benchmark scenes (engine-neutral [`SceneFile`]s) and scene transformations.
 //!
-//! `large_pyramid`, `many_pyramids`, `tumbler` (`tumbler_benchmark`: Box2D's scene with
-//! a kinematic drum instead of a motor-driven dynamic one), `compounds` and `washer` come
-//! from `tribo_scenes::scenes`; `smash` is built here following shared/SCENES.md §2 (Box2D v3's
+//! `large_pyramid`, `many_pyramids`, `tumbler` (`tumbler_benchmark`), `compounds`,
+//! `junkyard`, `joint_grid`, `spinner` and `washer` come from `tribo_scenes::scenes`; `smash` is built here following shared/SCENES.md §2 (Box2D v3's
 //! `CreateSmash`). The scaling run's scenes are `tribo_scenes::scenes::scaling_rain(n)`.
 
 use crate::engines::BoxError;
@@ -21,10 +20,23 @@ pub enum CheckKind {
     },
     /// The projectile must hit and plough into the block; momentum is conserved.
     Smash,
-    /// Every box's centre, in the frame of the kinematic drum (body 0; angle ω t), must
-    /// stay inside the drum: |x|, |y| < 9.5 m (the walls' inner faces); the engine's own
-    /// drum angle must match ω t within 0.01 rad.
+    /// Every box's centre, in the frame of the drum (the body named "drum", driven at ω by
+    /// its motor: angle ω t), must stay inside the drum: |x|, |y| < 9.5 m (the walls' inner
+    /// faces); the engine's own drum angle must match ω t within 0.01 rad.
     Tumbler,
+    /// Joint grid: every body finite, and every jointed pair's centres less than
+    /// `max_link` apart (the links are 1 m; a grid whose joints give way stretches or
+    /// tears).
+    JointGrid {
+        /// Largest centre distance of two jointed bodies [m].
+        max_link: f32,
+    },
+    /// Spinner: every body's centre inside the ring (`radius` of the ring centre) and the
+    /// rotor (the body named "rotor") turning at its motor speed within 1 %.
+    Spinner {
+        /// Inner radius of the ring [m].
+        radius: f32,
+    },
     /// Every box's centre must stay within the washer's rim (`radius` of the ring centre,
     /// which moves at the ring's constant velocity), and the engine's own ring angle must
     /// match ω t within 0.01 rad.
@@ -89,11 +101,7 @@ pub fn scenes() -> Vec<BenchScene> {
             CheckKind::Pyramid { stack_layers: 10 },
         ),
         BenchScene::new("smash", smash, CheckKind::Smash),
-        BenchScene {
-            note: "drum is KINEMATIC at a fixed 25°/s in all three engines (Box2D's scene: dynamic drum, \
-                   density 50, on a revolute motor; Tribo has no joints yet)",
-            ..BenchScene::new("tumbler", tribo_scenes::scenes::tumbler_benchmark, CheckKind::Tumbler)
-        },
+        BenchScene::new("tumbler", tribo_scenes::scenes::tumbler_benchmark, CheckKind::Tumbler),
         BenchScene {
             note: "check: body origins (the triangles' base centres) inside the container but for 1 % \
                    that may bounce over a wall onto the catch segment at y = -80 m (Box2D loses 2)",
@@ -116,6 +124,21 @@ pub fn scenes() -> Vec<BenchScene> {
                     half_width: tribo_scenes::scenes::JUNKYARD_INNER_HALF_WIDTH,
                     max_outside: 0,
                     catch_y: 0.0,
+                },
+            )
+        },
+        BenchScene::new(
+            "joint_grid",
+            tribo_scenes::scenes::joint_grid,
+            CheckKind::JointGrid { max_link: 1.25 },
+        ),
+        BenchScene {
+            note: "the ring is 360 quads 1 m thick in all three engines (Box2D's scene: a one-sided chain loop)",
+            ..BenchScene::new(
+                "spinner",
+                tribo_scenes::scenes::spinner,
+                CheckKind::Spinner {
+                    radius: tribo_scenes::scenes::SPINNER_RADIUS,
                 },
             )
         },
@@ -182,6 +205,7 @@ pub fn smash() -> SceneFile {
         enable_sleep: true,
         materials: Default::default(),
         bodies: Vec::with_capacity(1 + 120 * 80),
+        joints: Vec::new(),
     };
     // Box2D shape defaults: friction 0.6, restitution 0, density 1.
     let projectile_material = MaterialSpec {

@@ -61,6 +61,9 @@ fn every_scene_runs_for_every_engine() {
         "smash",
         "tumbler",
         "compounds",
+        "junkyard",
+        "joint_grid",
+        "spinner",
         "washer",
     ] {
         for engine in ["tribo", "box2d", "rapier"] {

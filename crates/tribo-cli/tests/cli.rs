@@ -204,6 +204,13 @@ fn malformed_scenes_are_rejected_with_their_place() {
 {{"name": "b", "type": "dynamic", "position": [0, 2], "shapes": [{shape}]}}]}}"#
         )
     };
+    let joint = |joint: &str| {
+        format!(
+            r#"{{"bodies": [{{"name": "g", "type": "static"}},
+{{"name": "b", "type": "dynamic", "position": [0, 2], "shapes": [{{"type": "circle", "radius": 0.5}}]}}],
+"joints": [{joint}]}}"#
+        )
+    };
     let cases: Vec<(&str, String, &str)> = vec![
         (
             "unknown field",
@@ -262,6 +269,36 @@ fn malformed_scenes_are_rejected_with_their_place() {
             "field of another shape",
             body(r#"{"type": "circle", "radius": 1, "half_extents": [1, 1]}"#),
             "half_extents",
+        ),
+        (
+            "joint to a body that does not exist",
+            joint(r#"{"body_a": 0, "body_b": 7, "anchor": [0, 0]}"#),
+            "joints[0].body_b",
+        ),
+        (
+            "joint to an unknown name",
+            joint(r#"{"body_a": "ground", "body_b": "b", "anchor": [0, 0]}"#),
+            "joints[0].body_a",
+        ),
+        (
+            "joint of a body with itself",
+            joint(r#"{"body_a": 1, "body_b": "b", "anchor": [0, 0]}"#),
+            "joints[0].body_b",
+        ),
+        (
+            "joint limits upside down",
+            joint(r#"{"body_a": 0, "body_b": 1, "anchor": [0, 0], "limit": [1, -1]}"#),
+            "joints[0].limit",
+        ),
+        (
+            "joint motor with negative torque",
+            joint(r#"{"body_a": 0, "body_b": 1, "anchor": [0, 0], "motor": {"speed": 1, "max_torque": -5}}"#),
+            "joints[0].motor.max_torque",
+        ),
+        (
+            "joint without anchor",
+            joint(r#"{"body_a": 0, "body_b": 1}"#),
+            "joints[0]",
         ),
     ];
     let dir = tmp_dir("malformed");

@@ -10,8 +10,8 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt;
 use tribo::{
-    BodyDef, BodyId, BodyType, Capsule, Circle, CombineRule, Material, Polygon, Segment, Shape, ShapeDef, Vec2, World,
-    WorldDef,
+    BodyDef, BodyId, BodyType, Capsule, Circle, CombineRule, Filter, Material, Polygon, RevoluteJointDef, Segment,
+    Shape, ShapeDef, Vec2, World, WorldDef,
 };
 
 /// A scene file.
@@ -42,6 +42,9 @@ pub struct SceneFile {
     /// The bodies, in creation order.
     #[serde(default)]
     pub bodies: Vec<BodySpec>,
+    /// The joints, created after the bodies, in this order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joints: Vec<JointSpec>,
 }
 
 fn default_gravity() -> [f32; 2] {
@@ -306,6 +309,154 @@ pub struct ShapeSpec {
     /// Material: a name from `materials` or an inline object. Default: the default material.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<MaterialRef>,
+    /// Collision filter (any shape type). Default: category 1, every mask bit, group 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filter: Option<FilterSpec>,
+}
+
+/// A shape's collision filter as written in a scene file (Box2D's scheme): two shapes
+/// collide when each one's category meets the other's mask, unless they share a non-zero
+/// group (positive: always collide, negative: never).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FilterSpec {
+    /// Category bits. Default 1.
+    #[serde(default = "default_category")]
+    pub category: u64,
+    /// Mask bits: the categories this shape collides with. Default every bit.
+    #[serde(default = "default_mask")]
+    pub mask: u64,
+    /// Group index. Default 0.
+    #[serde(default)]
+    pub group: i32,
+}
+
+fn default_category() -> u64 {
+    1
+}
+fn default_mask() -> u64 {
+    u64::MAX
+}
+
+impl From<FilterSpec> for Filter {
+    fn from(f: FilterSpec) -> Filter {
+        Filter {
+            category: f.category,
+            mask: f.mask,
+            group: f.group,
+        }
+    }
+}
+
+/// A body named in a joint: its index in `bodies`, or its `name`.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum BodyRef {
+    /// Index in the scene's `bodies`.
+    Index(usize),
+    /// A body's `name` (must name exactly one body).
+    Name(String),
+}
+
+/// Joint type in a scene file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum JointKind {
+    /// A hinge: the bodies share the anchor point and turn about it.
+    #[default]
+    Revolute,
+}
+
+/// A joint's motor as written in a scene file.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotorSpec {
+    /// Target relative angular speed ω_B − ω_A [rad/s].
+    pub speed: f32,
+    /// Largest motor torque [N·m], ≥ 0 (with speed 0: joint friction).
+    pub max_torque: f32,
+}
+
+/// A joint's angular spring as written in a scene file.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringSpec {
+    /// Frequency [Hz], > 0.
+    pub hertz: f32,
+    /// Damping ratio [-], ≥ 0. Default 0.
+    #[serde(default)]
+    pub damping_ratio: f32,
+}
+
+/// A joint as written in a scene file: a revolute joint about `anchor`, a world point at
+/// the bodies' initial poses (its angle is 0 in those poses).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpec {
+    /// "revolute" (the one joint type).
+    #[serde(rename = "type", default)]
+    pub kind: JointKind,
+    /// The first body.
+    pub body_a: BodyRef,
+    /// The second body.
+    pub body_b: BodyRef,
+    /// The pivot in world coordinates at the initial poses [m].
+    pub anchor: [f32; 2],
+    /// Angle limits [lower, upper] [rad]. Default: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limit: Option<[f32; 2]>,
+    /// Motor. Default: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motor: Option<MotorSpec>,
+    /// Angular spring towards angle 0. Default: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spring: Option<SpringSpec>,
+    /// Whether the two bodies' shapes still collide. Default false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub collide_connected: bool,
+    /// Soft position correction [Hz]. Default 60.
+    #[serde(
+        default = "default_constraint_hertz",
+        skip_serializing_if = "is_default_constraint_hertz"
+    )]
+    pub constraint_hertz: f32,
+    /// Damping ratio of the position correction [-]. Default 2.
+    #[serde(
+        default = "default_constraint_damping",
+        skip_serializing_if = "is_default_constraint_damping"
+    )]
+    pub constraint_damping_ratio: f32,
+}
+
+fn default_constraint_hertz() -> f32 {
+    tribo::DEFAULT_CONSTRAINT_HERTZ
+}
+fn is_default_constraint_hertz(x: &f32) -> bool {
+    *x == tribo::DEFAULT_CONSTRAINT_HERTZ
+}
+fn default_constraint_damping() -> f32 {
+    tribo::DEFAULT_CONSTRAINT_DAMPING_RATIO
+}
+fn is_default_constraint_damping(x: &f32) -> bool {
+    *x == tribo::DEFAULT_CONSTRAINT_DAMPING_RATIO
+}
+
+impl JointSpec {
+    /// A plain revolute joint between two bodies (by index) about a world point [m].
+    pub fn revolute(body_a: usize, body_b: usize, anchor: [f32; 2]) -> JointSpec {
+        JointSpec {
+            kind: JointKind::Revolute,
+            body_a: BodyRef::Index(body_a),
+            body_b: BodyRef::Index(body_b),
+            anchor,
+            limit: None,
+            motor: None,
+            spring: None,
+            collide_connected: false,
+            constraint_hertz: tribo::DEFAULT_CONSTRAINT_HERTZ,
+            constraint_damping_ratio: tribo::DEFAULT_CONSTRAINT_DAMPING_RATIO,
+        }
+    }
 }
 
 /// What is wrong with a scene file, and where.
@@ -409,6 +560,14 @@ fn finite(path: &str, v: f32) -> Result<(), Invalid> {
     }
 }
 
+fn non_negative(path: &str, v: f32) -> Result<(), Invalid> {
+    finite(path, v)?;
+    if v < 0.0 {
+        return Err((path.to_string(), format!("must not be negative (got {v})")));
+    }
+    Ok(())
+}
+
 fn finite2(path: &str, v: [f32; 2]) -> Result<(), Invalid> {
     if v[0].is_finite() && v[1].is_finite() {
         Ok(())
@@ -468,6 +627,73 @@ impl SceneFile {
                 }
             }
         }
+        for (i, j) in self.joints.iter().enumerate() {
+            self.validate_joint(&format!("joints[{i}]"), j)?;
+        }
+        Ok(())
+    }
+
+    /// The index of the body a joint names, with errors at `path`.
+    pub fn resolve_body(&self, path: &str, r: &BodyRef) -> Result<usize, Invalid> {
+        match r {
+            BodyRef::Index(i) if *i < self.bodies.len() => Ok(*i),
+            BodyRef::Index(i) => Err((
+                path.to_string(),
+                format!("no body {i} (the scene has {} bodies)", self.bodies.len()),
+            )),
+            BodyRef::Name(n) => {
+                let mut found = self
+                    .bodies
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, b)| b.name.as_deref() == Some(n));
+                match (found.next(), found.next()) {
+                    (Some((i, _)), None) => Ok(i),
+                    (None, _) => Err((path.to_string(), format!("no body is named \"{n}\""))),
+                    (Some(_), Some(_)) => Err((
+                        path.to_string(),
+                        format!("several bodies are named \"{n}\" (use the body's index)"),
+                    )),
+                }
+            }
+        }
+    }
+
+    fn validate_joint(&self, p: &str, j: &JointSpec) -> Result<(), Invalid> {
+        let a = self.resolve_body(&format!("{p}.body_a"), &j.body_a)?;
+        let b = self.resolve_body(&format!("{p}.body_b"), &j.body_b)?;
+        if a == b {
+            return Err((
+                format!("{p}.body_b"),
+                format!("must differ from body_a (both are body {a})"),
+            ));
+        }
+        finite2(&format!("{p}.anchor"), j.anchor)?;
+        if let Some([lower, upper]) = j.limit {
+            finite2(&format!("{p}.limit"), [lower, upper])?;
+            if lower > upper {
+                return Err((
+                    format!("{p}.limit"),
+                    format!("lower must be ≤ upper (got [{lower}, {upper}])"),
+                ));
+            }
+        }
+        if let Some(m) = j.motor {
+            finite(&format!("{p}.motor.speed"), m.speed)?;
+            non_negative(&format!("{p}.motor.max_torque"), m.max_torque)?;
+        }
+        if let Some(sp) = j.spring {
+            finite(&format!("{p}.spring.hertz"), sp.hertz)?;
+            if sp.hertz <= 0.0 {
+                return Err((
+                    format!("{p}.spring.hertz"),
+                    format!("must be positive (got {})", sp.hertz),
+                ));
+            }
+            non_negative(&format!("{p}.spring.damping_ratio"), sp.damping_ratio)?;
+        }
+        non_negative(&format!("{p}.constraint_hertz"), j.constraint_hertz)?;
+        non_negative(&format!("{p}.constraint_damping_ratio"), j.constraint_damping_ratio)?;
         Ok(())
     }
 
@@ -620,10 +846,12 @@ impl SceneFile {
                     column: 0,
                     message,
                 })?;
-                let material = self.shape_material(s);
-                world
-                    .create_shape(id, &ShapeDef::with_material(material), &geometry)
-                    .map_err(to_err(sp))?;
+                let def = ShapeDef {
+                    material: self.shape_material(s),
+                    filter: s.filter.map(Into::into).unwrap_or_default(),
+                    ..ShapeDef::default()
+                };
+                world.create_shape(id, &def, &geometry).map_err(to_err(sp))?;
             }
             // The velocity in the file is that of the centre of mass: set it after the
             // shapes moved the centre.
@@ -638,6 +866,33 @@ impl SceneFile {
                 }
             }
             bodies.push(id);
+        }
+        for (i, j) in self.joints.iter().enumerate() {
+            let p = format!("joints[{i}]");
+            let invalid = |(path, message): Invalid| SceneError {
+                path,
+                line: 0,
+                column: 0,
+                message,
+            };
+            let a = bodies[self.resolve_body(&p, &j.body_a).map_err(invalid)?];
+            let b = bodies[self.resolve_body(&p, &j.body_b).map_err(invalid)?];
+            let mut def = RevoluteJointDef::at(&world, a, b, Vec2::new(j.anchor[0], j.anchor[1]))
+                .map_err(to_err(format!("{p}.anchor")))?;
+            if let Some([lower, upper]) = j.limit {
+                def = def.limit(lower, upper);
+            }
+            if let Some(m) = j.motor {
+                def = def.motor(m.speed, m.max_torque);
+            }
+            if let Some(sp) = j.spring {
+                def = def.spring(sp.hertz, sp.damping_ratio);
+            }
+            def.collide_connected = j.collide_connected;
+            def.constraint_hertz = j.constraint_hertz;
+            def.constraint_damping_ratio = j.constraint_damping_ratio;
+            def.user_data = i as u64;
+            world.create_revolute_joint(&def).map_err(to_err(p))?;
         }
         Ok(BuiltScene {
             world,

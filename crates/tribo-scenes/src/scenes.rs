@@ -2,7 +2,9 @@
 //! description that the CLI runs and renders, `tribo export` writes, and the benchmarks
 //! build for every engine.
 
-use crate::format::{BodyKind, BodySpec, MaterialRef, MaterialSpec, SceneFile, ShapeSpec};
+use crate::format::{
+    BodyKind, BodySpec, FilterSpec, JointSpec, MaterialRef, MaterialSpec, MotorSpec, SceneFile, ShapeSpec,
+};
 use std::collections::BTreeMap;
 
 /// A built-in scene: name, one line of description, builder.
@@ -64,9 +66,18 @@ pub const SCENES: &[SceneEntry] = &[
     },
     SceneEntry {
         name: "tumbler_benchmark",
-        about:
-            "Box2D v3 benchmark tumbler: 2 025 small boxes in a 20 m drum turning at 25°/s (kinematic here), 750 steps",
+        about: "Box2D v3 benchmark tumbler: 2 025 small boxes in a 20 m drum driven at 25°/s by a revolute motor, 750 steps",
         build: tumbler_benchmark,
+    },
+    SceneEntry {
+        name: "joint_grid",
+        about: "Box2D v3 benchmark: a 100 × 100 grid of circles hanging on 19 800 revolute joints, 500 steps",
+        build: joint_grid,
+    },
+    SceneEntry {
+        name: "spinner",
+        about: "Box2D v3 benchmark: a rotor on a revolute motor stirring 6 076 bodies in a 40 m ring, 500 steps",
+        build: spinner,
     },
     SceneEntry {
         name: "scaling_rain_1k",
@@ -115,6 +126,7 @@ fn scene(description: &str, steps: u32) -> SceneFile {
         enable_sleep: true,
         materials: BTreeMap::new(),
         bodies: Vec::new(),
+        joints: Vec::new(),
     }
 }
 
@@ -464,24 +476,23 @@ pub const TUMBLER_DRUM_SPEED: f32 = 25.0 * core::f32::consts::PI / 180.0;
 /// Centre of the tumbler benchmark's drum [m].
 pub const TUMBLER_DRUM_CENTER: [f32; 2] = [0.0, 10.0];
 
-/// Box2D v3's tumbler benchmark scene (SCENES.md §2, `CreateTumbler`), with one
-/// difference: the drum is a **kinematic** body turning at a fixed 25°/s
-/// ([`TUMBLER_DRUM_SPEED`], ≈ 0.436 rad/s, counter-clockwise) about its centre (0, 10) m.
-/// In Box2D's scene the drum is a *dynamic* body (density 50) driven by a revolute-joint
-/// motor (25°/s, max torque 1e8 N·m) to a static ground body; Tribo has no joints yet, so
-/// the benchmark gives every engine the kinematic drum (same work for all three; the
-/// motor joint, its solver row and the drum's own dynamics are absent, and the drum never
-/// slows down under the load of the boxes).
+/// Largest torque of the tumbler benchmark's drum motor [N·m] (Box2D's scene: 1e8).
+pub const TUMBLER_MOTOR_TORQUE: f32 = 1.0e8;
+
+/// Box2D v3's tumbler benchmark scene (SCENES.md §2, `CreateTumbler`).
 ///
-/// Drum: four boxes, half (0.5, 10) m at (±10, 0) m and half (10, 0.5) m at (0, ±10) m in
-/// the drum's frame, so the inside is 19 m × 19 m; density 50 kg/m² (kept from Box2D's
-/// scene; no effect on a kinematic body). Contents: 45 × 45 = 2 025 dynamic boxes, half
-/// 0.125 m, density 1 kg/m², friction 0.6, at x = −9 + 0.4 j, y = 1 + 0.4 i m (row i,
-/// column j). Gravity (0, −10) m/s², 60 Hz, 4 substeps, sleep on, 750 steps (12.5 s,
-/// 312.5° of drum rotation).
+/// Body 0: a static ground body at the origin without shapes. Body 1, "drum": a dynamic
+/// body at (0, 10) m of four boxes, half (0.5, 10) m at (±10, 0) m and half (10, 0.5) m
+/// at (0, ±10) m in its frame (inside 19 m × 19 m), density 50 kg/m², hinged to the
+/// ground at its centre by a revolute joint whose motor turns it at 25°/s
+/// ([`TUMBLER_DRUM_SPEED`], ≈ 0.436 rad/s, counter-clockwise) with at most
+/// [`TUMBLER_MOTOR_TORQUE`]. Contents: 45 × 45 = 2 025 dynamic boxes, half 0.125 m,
+/// density 1 kg/m², friction 0.6, at x = −9 + 0.4 j, y = 1 + 0.4 i m (row i, column j).
+/// Gravity (0, −10) m/s², 60 Hz, 4 substeps, sleep on, 750 steps (12.5 s, 312.5° of drum
+/// rotation).
 pub fn tumbler_benchmark() -> SceneFile {
     let mut s = scene(
-        "Box2D v3 benchmark tumbler with a kinematic drum at 25°/s (Box2D: dynamic drum on a revolute motor)",
+        "Box2D v3 benchmark tumbler: a dynamic drum on a revolute motor at 25°/s, 2 025 boxes",
         750,
     );
     s.gravity = [0.0, -10.0];
@@ -502,16 +513,29 @@ pub fn tumbler_benchmark() -> SceneFile {
             ..MaterialSpec::default()
         },
     );
+    s.bodies.push(body(
+        Some("ground".into()),
+        BodyKind::Static,
+        [0.0, 0.0],
+        0.0,
+        Vec::new(),
+    ));
     let mut drum = body(
         Some("drum".into()),
-        BodyKind::Kinematic,
+        BodyKind::Dynamic,
         TUMBLER_DRUM_CENTER,
         0.0,
         Vec::new(),
     );
-    drum.angular_velocity = TUMBLER_DRUM_SPEED;
     drum.shapes = drum_walls(named("drum"));
     s.bodies.push(drum);
+    s.joints.push(JointSpec {
+        motor: Some(MotorSpec {
+            speed: TUMBLER_DRUM_SPEED,
+            max_torque: TUMBLER_MOTOR_TORQUE,
+        }),
+        ..JointSpec::revolute(0, 1, TUMBLER_DRUM_CENTER)
+    });
     for i in 0..45 {
         for j in 0..45 {
             let p = [-9.0 + 0.4 * j as f32, 1.0 + 0.4 * i as f32];
@@ -522,6 +546,170 @@ pub fn tumbler_benchmark() -> SceneFile {
                 0.0,
                 vec![box_shape(0.125, 0.125, named("box"))],
             ));
+        }
+    }
+    s
+}
+
+/// Side of Box2D's joint grid [bodies].
+pub const JOINT_GRID_N: usize = 100;
+
+/// Box2D v3's joint_grid benchmark scene (SCENES.md §2, `CreateJointGrid`): a pure joint
+/// benchmark. A 100 × 100 grid of bodies, body (k, i) (column k, row i, created k outer,
+/// i inner) at (k, −i) m with one circle of radius 0.4 m (density 1 kg/m², friction 0.6,
+/// filter category 0x2 and mask ¬0x2, so no two circles ever collide: no contacts), the
+/// bodies of row 0 in columns 47 … 53 static (the grid hangs from them), the others
+/// dynamic. Revolute joints with Box2D's defaults (no limit, motor or spring; 60 Hz,
+/// ζ 2 correction): each body to the one above it at the point 0.5 m above its centre, and
+/// to the one on its left at the point 0.5 m to its left: 2 × 100 × 99 = 19 800 joints.
+/// Gravity (0, −10) m/s², sleep off, 500 steps.
+pub fn joint_grid() -> SceneFile {
+    let mut s = scene(
+        "Box2D v3 benchmark: a 100 × 100 grid of circles on 19 800 revolute joints",
+        500,
+    );
+    s.gravity = [0.0, -10.0];
+    s.enable_sleep = false;
+    let n = JOINT_GRID_N;
+    let filter = FilterSpec {
+        category: 0x2,
+        mask: !0x2,
+        group: 0,
+    };
+    s.bodies.reserve(n * n);
+    s.joints.reserve(2 * n * (n - 1));
+    for k in 0..n {
+        for i in 0..n {
+            let pinned = i == 0 && (n / 2 - 3..=n / 2 + 3).contains(&k);
+            let kind = if pinned { BodyKind::Static } else { BodyKind::Dynamic };
+            let (x, y) = (k as f32, -(i as f32));
+            let shape = ShapeSpec {
+                filter: Some(filter),
+                ..circle_shape(0.4, None)
+            };
+            let index = s.bodies.len();
+            s.bodies.push(body(None, kind, [x, y], 0.0, vec![shape]));
+            if i > 0 {
+                s.joints.push(JointSpec::revolute(index - 1, index, [x, y + 0.5]));
+            }
+            if k > 0 {
+                s.joints.push(JointSpec::revolute(index - n, index, [x - 0.5, y]));
+            }
+        }
+    }
+    s
+}
+
+/// Centre [m] and radius [m] of the spinner benchmark's circular wall.
+pub const SPINNER_CENTER: [f32; 2] = [0.0, 32.0];
+/// Radius of the spinner's wall [m].
+pub const SPINNER_RADIUS: f32 = 40.0;
+/// Speed of the spinner's rotor motor [rad/s].
+pub const SPINNER_MOTOR_SPEED: f32 = 5.0;
+/// Thickness [m] of the spinner's wall pieces, outward from the ring.
+pub const SPINNER_WALL: f32 = 1.0;
+
+/// Box2D v3's spinner benchmark scene (SCENES.md §2, `CreateSpinner`, HEAD sizes).
+///
+/// Body 0: static ground, a closed ring through 360 points on a circle of radius 40 m
+/// about (0, 32) m, friction 0.1. Box2D's ring is a one-sided chain loop (wound
+/// clockwise: it pushes everything inwards); here each of its 360 pieces is a quad
+/// reaching [`SPINNER_WALL`] outwards from the chain's segment, so it is one-sided in
+/// effect in every engine. Two-sided segments are not: the rotor's rounded tip reaches
+/// 20.2 m from its pivot, 0.2 m past the ring at its lowest point, and bodies it squeezes
+/// there more than halfway through a segment are pushed out (Tribo lost 23 of 6 076 over
+/// 500 steps that way). Body 1,
+/// "rotor": a dynamic rounded box half (0.4, 20) m with radius 0.2 m at (0, 12) m,
+/// friction 0, density 1 kg/m², hinged to the ground at its centre by a revolute motor at
+/// 5 rad/s with unbounded torque (`f32::MAX`, as Box2D HEAD). Then 6 076 dynamic bodies,
+/// density 0.25 kg/m², friction 0.1, restitution 0.1, cycling by creation index mod 3
+/// through a capsule (±0.25, 0) m radius 0.25 m, a circle of radius 0.35 m and a square of
+/// half 0.35 m, placed from (−23, 2) m stepping 0.5 m in x and wrapping to x = −23, y +=
+/// 0.5 m when x reaches 23 (92 per row; the rotor overlaps the middle columns at
+/// creation, as in Box2D). Gravity (0, −10) m/s², sleep on, 500 steps.
+pub fn spinner() -> SceneFile {
+    let mut s = scene(
+        "Box2D v3 benchmark: a motor-driven rotor stirring 6 076 bodies in a ring",
+        500,
+    );
+    s.gravity = [0.0, -10.0];
+    s.enable_sleep = true;
+    let wall_material = MaterialSpec {
+        friction: Some(0.1),
+        ..MaterialSpec::default()
+    };
+    // Point k of the ring at radius r (clockwise, as Box2D's chain).
+    let point = |k: usize, r: f32| {
+        let a = -(k as f32) * core::f32::consts::TAU / 360.0;
+        [SPINNER_CENTER[0] + r * a.cos(), SPINNER_CENTER[1] + r * a.sin()]
+    };
+    let walls = (0..360)
+        .map(|k| {
+            let outer = SPINNER_RADIUS + SPINNER_WALL;
+            polygon_shape(
+                vec![
+                    point(k, SPINNER_RADIUS),
+                    point(k + 1, SPINNER_RADIUS),
+                    point(k + 1, outer),
+                    point(k, outer),
+                ],
+                Some(MaterialRef::Inline(wall_material.clone())),
+            )
+        })
+        .collect();
+    s.bodies
+        .push(body(Some("ground".into()), BodyKind::Static, [0.0, 0.0], 0.0, walls));
+    let rotor_material = MaterialSpec {
+        density: Some(1.0),
+        friction: Some(0.0),
+        ..MaterialSpec::default()
+    };
+    let rotor_shape = ShapeSpec {
+        radius: Some(0.2),
+        ..polygon_shape(
+            vec![[-0.4, -20.0], [0.4, -20.0], [0.4, 20.0], [-0.4, 20.0]],
+            Some(MaterialRef::Inline(rotor_material)),
+        )
+    };
+    s.bodies.push(body(
+        Some("rotor".into()),
+        BodyKind::Dynamic,
+        [0.0, 12.0],
+        0.0,
+        vec![rotor_shape],
+    ));
+    s.joints.push(JointSpec {
+        motor: Some(MotorSpec {
+            speed: SPINNER_MOTOR_SPEED,
+            max_torque: f32::MAX,
+        }),
+        ..JointSpec::revolute(0, 1, [0.0, 12.0])
+    });
+    let m = Some(MaterialRef::Inline(MaterialSpec {
+        density: Some(0.25),
+        friction: Some(0.1),
+        restitution: Some(0.1),
+        ..MaterialSpec::default()
+    }));
+    let (mut x, mut y) = (-23.0f32, 2.0f32);
+    for k in 0..6076 {
+        let shape = match k % 3 {
+            0 => ShapeSpec {
+                kind: "capsule".into(),
+                center1: Some([-0.25, 0.0]),
+                center2: Some([0.25, 0.0]),
+                radius: Some(0.25),
+                material: m.clone(),
+                ..ShapeSpec::default()
+            },
+            1 => circle_shape(0.35, m.clone()),
+            _ => box_shape(0.35, 0.35, m.clone()),
+        };
+        s.bodies.push(body(None, BodyKind::Dynamic, [x, y], 0.0, vec![shape]));
+        x += 0.5;
+        if x >= 23.0 {
+            x = -23.0;
+            y += 0.5;
         }
     }
     s
@@ -884,16 +1072,21 @@ mod benchmark_scene_tests {
     use super::*;
 
     #[test]
-    fn tumbler_benchmark_matches_scenes_md_but_for_the_kinematic_drum() {
+    fn tumbler_benchmark_matches_scenes_md() {
         let s = tumbler_benchmark();
         assert_eq!((s.steps, s.gravity, s.enable_sleep), (750, [0.0, -10.0], true));
-        assert_eq!(s.bodies.len(), 1 + 45 * 45);
-        let drum = &s.bodies[0];
-        assert_eq!(drum.kind, BodyKind::Kinematic);
+        assert_eq!(s.bodies.len(), 2 + 45 * 45);
+        assert_eq!((s.bodies[0].kind, s.bodies[0].shapes.len()), (BodyKind::Static, 0));
+        let drum = &s.bodies[1];
+        assert_eq!(drum.kind, BodyKind::Dynamic);
         assert_eq!(drum.position, [0.0, 10.0]);
-        assert!((drum.angular_velocity - 0.436).abs() < 1e-3);
         assert_eq!(drum.shapes.len(), 4);
         assert_eq!(s.shape_material(&drum.shapes[0]).density, 50.0);
+        assert_eq!(s.joints.len(), 1);
+        let j = &s.joints[0];
+        assert_eq!(j.anchor, [0.0, 10.0]);
+        let motor = j.motor.expect("motor");
+        assert!((motor.speed - 0.436).abs() < 1e-3 && motor.max_torque == 1e8);
         let last = s.bodies.last().expect("boxes");
         assert_eq!(last.kind, BodyKind::Dynamic);
         assert!((last.position[0] - (-9.0 + 0.4 * 44.0)).abs() < 1e-5);
@@ -901,6 +1094,45 @@ mod benchmark_scene_tests {
         let m = s.shape_material(&last.shapes[0]);
         assert_eq!((m.density, m.friction_static, m.friction_dynamic), (1.0, 0.6, 0.6));
         assert_eq!(last.shapes[0].half_extents, Some([0.125, 0.125]));
+    }
+
+    #[test]
+    fn joint_grid_matches_scenes_md() {
+        let s = joint_grid();
+        assert_eq!((s.steps, s.gravity, s.enable_sleep), (500, [0.0, -10.0], false));
+        assert_eq!(s.bodies.len(), 10_000);
+        assert_eq!(s.joints.len(), 19_800);
+        let statics: Vec<[f32; 2]> = s
+            .bodies
+            .iter()
+            .filter(|b| b.kind == BodyKind::Static)
+            .map(|b| b.position)
+            .collect();
+        assert_eq!(statics, (47..=53).map(|k| [k as f32, 0.0]).collect::<Vec<_>>());
+        // Body (k, i) is index 100 k + i at (k, −i); its vertical joint's anchor is 0.5 m up.
+        assert_eq!(s.bodies[100 * 3 + 7].position, [3.0, -7.0]);
+        let f = s.bodies[0].shapes[0].filter.expect("filter");
+        assert!(f.category & f.mask == 0, "circles never collide with each other");
+        // The whole scene builds: no contact at all after a step.
+        let mut built = s.build().expect("builds");
+        built.world.step(built.dt).expect("steps");
+        assert_eq!(built.world.joint_count(), 19_800);
+        assert_eq!(built.world.contact_count(), 0);
+    }
+
+    #[test]
+    fn spinner_matches_scenes_md() {
+        let s = spinner();
+        assert_eq!((s.steps, s.gravity, s.enable_sleep), (500, [0.0, -10.0], true));
+        assert_eq!(s.bodies.len(), 2 + 6076);
+        assert_eq!(s.bodies[0].shapes.len(), 360);
+        assert_eq!(s.bodies[0].shapes[0].kind, "polygon");
+        let motor = s.joints[0].motor.expect("motor");
+        assert_eq!((motor.speed, s.joints[0].anchor), (5.0, [0.0, 12.0]));
+        // 92 bodies per row from (−23, 2): the 93rd starts the second row.
+        assert_eq!(s.bodies[2 + 92].position, [-23.0, 2.5]);
+        let kinds: Vec<&str> = s.bodies[2..5].iter().map(|b| b.shapes[0].kind.as_str()).collect();
+        assert_eq!(kinds, ["capsule", "circle", "box"]);
     }
 
     #[test]

@@ -2,9 +2,11 @@
 //! the serde types of the scene format in `tribo_scenes::format`.
 //!
 //! - the schema is JSON, draft 2020-12, and every `$ref` resolves;
-//! - the property names of scene, material, body and shapes are exactly the serde fields
-//!   (found by serializing a scene with every optional field set);
-//! - the enums (body type, shape type, combine rules) are exactly the serde variants;
+//! - the property names of scene, material, body, shapes, filter, joint, motor and spring
+//!   are exactly the serde fields (found by serializing a scene with every optional field
+//!   set);
+//! - the enums (body type, shape type, combine rules, joint type) are exactly the serde
+//!   variants;
 //! - each shape type's fields and required fields in the schema are what the loader accepts
 //!   and requires, and every `default` in the schema is what the loader uses;
 //! - every built-in scene, and the documentation's example, only use what the schema knows.
@@ -12,7 +14,10 @@
 use serde_json::{json, Map, Value};
 use std::collections::{BTreeMap, BTreeSet};
 use tribo::Material;
-use tribo_scenes::format::{self, BodyKind, BodySpec, MaterialRef, MaterialSpec, RuleName, SceneFile, ShapeSpec};
+use tribo_scenes::format::{
+    self, BodyKind, BodyRef, BodySpec, FilterSpec, JointKind, JointSpec, MaterialRef, MaterialSpec, MotorSpec,
+    RuleName, SceneFile, ShapeSpec, SpringSpec,
+};
 use tribo_scenes::scenes::SCENES;
 
 const SCHEMA: &str = include_str!("../../../docs/scene.schema.json");
@@ -134,6 +139,32 @@ fn full_shape() -> ShapeSpec {
         point1: Some([0.0, 0.0]),
         point2: Some([1.0, 0.0]),
         material: Some(MaterialRef::Inline(full_material())),
+        filter: Some(FilterSpec {
+            category: 2,
+            mask: 5,
+            group: -1,
+        }),
+    }
+}
+
+fn full_joint() -> JointSpec {
+    JointSpec {
+        kind: JointKind::Revolute,
+        body_a: BodyRef::Index(0),
+        body_b: BodyRef::Name("b".into()),
+        anchor: [1.0, 2.0],
+        limit: Some([-0.5, 0.5]),
+        motor: Some(MotorSpec {
+            speed: 1.0,
+            max_torque: 10.0,
+        }),
+        spring: Some(SpringSpec {
+            hertz: 2.0,
+            damping_ratio: 0.3,
+        }),
+        collide_connected: true,
+        constraint_hertz: 30.0,
+        constraint_damping_ratio: 1.0,
     }
 }
 
@@ -166,6 +197,7 @@ fn full_scene() -> SceneFile {
         enable_sleep: false,
         materials: BTreeMap::from([("m".to_string(), full_material())]),
         bodies: vec![full_body()],
+        joints: vec![full_joint()],
     }
 }
 
@@ -207,6 +239,7 @@ fn sample(field: &str) -> Value {
         "center1" | "point1" => json!([0, 0]),
         "center2" | "point2" => json!([1, 0]),
         "material" => json!({ "friction": 0.5 }),
+        "filter" => json!({ "category": 2, "mask": 1, "group": 0 }),
         other => panic!("no sample value for shape field {other}"),
     }
 }
@@ -272,11 +305,15 @@ fn every_object_forbids_unknown_fields() {
 fn every_field_has_a_description_with_unit_and_a_default() {
     let root = schema();
     // Fields that are optional but have no fixed value to write as "default".
-    let no_default = ["description", "name", "material"];
+    let no_default = ["description", "name", "material", "filter", "limit", "motor", "spring"];
     let mut objects: Vec<(String, &Value)> = vec![
         ("scene".into(), &root),
         ("material".into(), def(&root, "material")),
         ("body".into(), def(&root, "body")),
+        ("filter".into(), def(&root, "filter")),
+        ("joint".into(), def(&root, "joint")),
+        ("motor".into(), def(&root, "motor")),
+        ("spring".into(), def(&root, "spring")),
     ];
     for (name, v) in shape_variants(&root) {
         objects.push((name, v));
@@ -325,6 +362,19 @@ fn schema_properties_are_the_serde_fields() {
     );
 
     assert_eq!(keys(&full["bodies"][0]), prop_names(def(&root, "body")), "body fields");
+    assert_eq!(
+        keys(&full["bodies"][0]["shapes"][0]["filter"]),
+        prop_names(def(&root, "filter")),
+        "filter fields"
+    );
+    let joint = &full["joints"][0];
+    assert_eq!(keys(joint), prop_names(def(&root, "joint")), "joint fields");
+    assert_eq!(keys(&joint["motor"]), prop_names(def(&root, "motor")), "motor fields");
+    assert_eq!(
+        keys(&joint["spring"]),
+        prop_names(def(&root, "spring")),
+        "spring fields"
+    );
 
     let variants = shape_variants(&root);
     let union: BTreeSet<String> = variants.values().flat_map(|v| prop_names(v)).collect();
@@ -332,8 +382,8 @@ fn schema_properties_are_the_serde_fields() {
     for (name, v) in &variants {
         let names = prop_names(v);
         assert!(
-            names.contains("type") && names.contains("material"),
-            "{name}: type and material"
+            names.contains("type") && names.contains("material") && names.contains("filter"),
+            "{name}: type, material and filter"
         );
     }
 }
@@ -370,6 +420,17 @@ fn schema_enums_are_the_serde_variants() {
         .map(String::from)
         .collect();
     assert_eq!(variants, expected, "shape types the loader knows");
+
+    let joint_kinds: BTreeSet<String> = [JointKind::Revolute]
+        .iter()
+        .map(|k| {
+            match k {
+                JointKind::Revolute => {}
+            }
+            to_value(k).as_str().expect("string").to_string()
+        })
+        .collect();
+    assert_eq!(joint_kinds, enum_strings(&properties(def(&root, "joint"))["type"]));
 }
 
 /// Each shape type's fields and required fields in the schema are those the loader takes.
@@ -438,6 +499,36 @@ fn schema_defaults_are_the_loader_defaults() {
         if let Some(d) = prop.get("default") {
             let got = parse(json!({ "bodies": [{ field: d }] }).to_string());
             assert_eq!(got, empty, "body.{field}: default {d}");
+        }
+    }
+
+    // Joints, on a scene with a static and a dynamic body.
+    let two = json!([{}, { "type": "dynamic" }]);
+    let joint = json!({ "body_a": 0, "body_b": 1, "anchor": [0, 0] });
+    let empty = parse(json!({ "bodies": two, "joints": [joint] }).to_string());
+    for (field, prop) in properties(def(&root, "joint")) {
+        if let Some(d) = prop.get("default") {
+            let mut with = joint.clone();
+            with[field.as_str()] = d.clone();
+            let got = parse(json!({ "bodies": two, "joints": [with] }).to_string());
+            assert_eq!(got, empty, "joint.{field}: default {d}");
+        }
+    }
+    for (field, prop) in properties(def(&root, "spring")) {
+        if let Some(d) = prop.get("default") {
+            let spring: SpringSpec = serde_json::from_value(json!({ "hertz": 1, field: d })).expect("spring");
+            let plain: SpringSpec = serde_json::from_value(json!({ "hertz": 1 })).expect("spring");
+            assert_eq!(spring, plain, "spring.{field}: default {d}");
+        }
+    }
+    for (field, prop) in properties(def(&root, "filter")) {
+        if let Some(d) = prop.get("default") {
+            let f: FilterSpec = serde_json::from_value(json!({ field: d })).expect("filter");
+            assert_eq!(
+                tribo::Filter::from(f),
+                tribo::Filter::default(),
+                "filter.{field}: default {d}"
+            );
         }
     }
 
@@ -603,6 +694,10 @@ fn the_checker_rejects_what_the_schema_forbids() {
         json!({ "dt": 0 }),
         json!({ "substeps": 65 }),
         json!({ "gravity": [0, -9.81, 0] }),
+        json!({ "bodies": [{}, { "type": "dynamic" }], "joints": [{ "body_a": 0, "body_b": 1 }] }),
+        json!({ "bodies": [{}, { "type": "dynamic" }], "joints": [{ "body_a": 0, "body_b": 1, "anchor": [0, 0], "kind": "weld" }] }),
+        json!({ "bodies": [{}, { "type": "dynamic" }], "joints": [{ "body_a": 0, "body_b": 1, "anchor": [0, 0], "motor": { "speed": 1, "max_torque": -1 } }] }),
+        json!({ "bodies": [{ "shapes": [{ "type": "circle", "radius": 1, "filter": { "category": -1 } }] }] }),
     ];
     for value in bad {
         assert!(

@@ -434,7 +434,6 @@ fn a_jointed_chain_sleeps_and_wakes_as_one_island() {
 #[test]
 fn bad_joint_input_is_rejected_and_changes_nothing() {
     let (mut w, ground, d) = wheel(0.5);
-    let other = w.create_body(&BodyDef::fixed(Vec2::new(3.0, 0.0))).unwrap();
     let good = RevoluteJointDef::new(ground, d, Vec2::ZERO, Vec2::ZERO);
     let nan = RevoluteJointDef {
         local_anchor_a: Vec2::new(f32::NAN, 0.0),
@@ -447,7 +446,6 @@ fn bad_joint_input_is_rejected_and_changes_nothing() {
         (good.motor(f32::INFINITY, 2.0), "motor_speed"),
         (good.spring(0.0, 0.5), "spring_hertz"),
         (RevoluteJointDef::new(d, d, Vec2::ZERO, Vec2::ZERO), "body_b"),
-        (RevoluteJointDef::new(ground, other, Vec2::ZERO, Vec2::ZERO), "body_b"),
     ];
     for (def, field) in cases {
         match w.create_revolute_joint(&def) {
