@@ -71,4 +71,6 @@ pub struct Frame {
     pub shapes: Vec<DrawShape>,
     /// Contact points, drawn on top.
     pub contacts: Vec<DrawContact>,
+    /// Joint pivots [m] (each as body B holds it), drawn as small rings on top.
+    pub joints: Vec<[f32; 2]>,
 }

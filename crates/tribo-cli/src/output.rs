@@ -203,6 +203,11 @@ impl Simulation {
                 });
             }
         }
+        for j in world.joint_ids() {
+            if let Ok((_, b)) = world.joint_world_anchors(j) {
+                frame.joints.push([b.x, b.y]);
+            }
+        }
         frame
     }
 

@@ -6,7 +6,8 @@
 //! written out as SVG text, so every output format has the same look:
 //! light paper background, a 1 m grid, shapes with dark outlines, hatched
 //! static ground, contact points as blue (stick) or orange-red (slip) dots
-//! with a normal tick, a time label, a legend and a scale bar.
+//! with a normal tick, joint pivots as small rings, a time label, a legend and a
+//! scale bar.
 
 use std::borrow::Cow;
 use std::collections::HashMap;
@@ -43,6 +44,8 @@ const OUTLINE_WIDTH: f32 = 1.5;
 const HATCH_SPACING: f32 = 7.0;
 /// Contact dot radius [px].
 const CONTACT_RADIUS: f32 = 3.5;
+/// Radius of a joint pivot's ring [px].
+const JOINT_RADIUS: f32 = 3.0;
 /// Length of the contact normal tick [px].
 const CONTACT_TICK: f32 = 14.0;
 /// Distance of the overlay panels from the image border [px].
@@ -847,6 +850,29 @@ impl<'a> Scene<'a> {
         });
     }
 
+    /// A joint pivot: a small white ring with a dark outline.
+    fn joint(&mut self, at: [f32; 2]) {
+        if !finite2(at) {
+            return;
+        }
+        let p = self.cam.to_pixel(at);
+        if p[0] < self.clip_min[0] || p[0] > self.clip_max[0] || p[1] < self.clip_min[1] || p[1] > self.clip_max[1] {
+            return;
+        }
+        let k = if text_scale(self.cam.width, self.cam.height) >= 2 {
+            1.0
+        } else {
+            0.7
+        };
+        self.prims.push(Prim::Circle {
+            c: p,
+            r: JOINT_RADIUS * k,
+            fill: Some(HALO),
+            hatch: false,
+            stroke: Some((OUTLINE, 1.5 * k)),
+        });
+    }
+
     fn overlays(&mut self, time: f32) {
         let cam = self.cam;
         let (w, h) = (cam.width as f32, cam.height as f32);
@@ -1020,6 +1046,9 @@ fn build_scene(frame: &Frame, camera: &Camera) -> Vec<Prim> {
     }
     for c in &frame.contacts {
         scene.contact(c);
+    }
+    for &j in &frame.joints {
+        scene.joint(j);
     }
     scene.overlays(frame.time);
     scene.prims
@@ -1802,6 +1831,7 @@ mod tests {
                     stick: false,
                 },
             ],
+            joints: vec![[2.0 + dx, 1.5]],
         }
     }
 
@@ -1941,6 +1971,7 @@ mod tests {
             time: 0.0,
             shapes: vec![ground.clone()],
             contacts: vec![],
+            joints: vec![],
         };
         let cam = Camera::fit(std::slice::from_ref(&only_ground), 960, 600);
         assert_sane(&cam);
@@ -1960,6 +1991,7 @@ mod tests {
             time: 0.0,
             shapes: vec![ground, ball],
             contacts: vec![],
+            joints: vec![],
         };
         let cam = Camera::fit(std::slice::from_ref(&small), 960, 600);
         assert_sane(&cam);
@@ -1981,6 +2013,7 @@ mod tests {
                 time: 0.0,
                 shapes: vec![dot],
                 contacts: vec![],
+                joints: vec![],
             }],
             640,
             400,
@@ -2002,6 +2035,7 @@ mod tests {
             time: f32::NAN,
             shapes: vec![bad],
             contacts: vec![],
+            joints: vec![],
         };
         let cam = Camera::fit(std::slice::from_ref(&frame), 640, 400);
         assert_sane(&cam);
