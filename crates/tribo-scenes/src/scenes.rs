@@ -607,7 +607,7 @@ pub const SPINNER_RADIUS: f32 = 40.0;
 /// Speed of the spinner's rotor motor [rad/s].
 pub const SPINNER_MOTOR_SPEED: f32 = 5.0;
 /// Thickness [m] of the spinner's wall pieces, outward from the ring.
-pub const SPINNER_WALL: f32 = 1.0;
+pub const SPINNER_WALL: f32 = 2.5;
 
 /// Box2D v3's spinner benchmark scene (SCENES.md §2, `CreateSpinner`, HEAD sizes).
 ///
@@ -618,7 +618,8 @@ pub const SPINNER_WALL: f32 = 1.0;
 /// effect in every engine. Two-sided segments are not: the rotor's rounded tip reaches
 /// 20.2 m from its pivot, 0.2 m past the ring at its lowest point, and bodies it squeezes
 /// there more than halfway through a segment are pushed out (Tribo lost 23 of 6 076 over
-/// 500 steps that way). Body 1,
+/// 500 steps that way); with pieces 1 m thick a few bodies driven deep by the rotor still
+/// left through the back with μs raised to 1.5 μd. Body 1,
 /// "rotor": a dynamic rounded box half (0.4, 20) m with radius 0.2 m at (0, 12) m,
 /// friction 0, density 1 kg/m², hinged to the ground at its centre by a revolute motor at
 /// 5 rad/s with unbounded torque (`f32::MAX`, as Box2D HEAD). Then 6 076 dynamic bodies,

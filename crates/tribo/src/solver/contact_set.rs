@@ -28,9 +28,9 @@
 //! [`team_loop`]: ContactSolver::team_loop
 
 use super::contact_solver::{
-    build_constraint, end_substep_one, estimate, has_fresh_point, is_new_resting, record_approach, restitution_one,
-    solve_one, store_impulses, warm_start_one, ConstraintBodies, ContactConstraint, ContactInput, StepSoftness,
-    MASS_RATIO_GROUP, MAX_ESTIMATE_SWEEPS, MAX_LOCAL_SWEEPS, ONGOING_ESTIMATE_SWEEPS,
+    bounces, build_constraint, end_substep_one, estimate, has_fresh_point, is_new_resting, record_approach,
+    restitution_one, solve_one, store_impulses, warm_start_one, ConstraintBodies, ContactConstraint, ContactInput,
+    StepSoftness, MASS_RATIO_GROUP, MAX_ESTIMATE_SWEEPS, MAX_LOCAL_SWEEPS, ONGOING_ESTIMATE_SWEEPS,
 };
 use super::contact_wide::{self, StoredContact, WideCold, WideContact, WideHead, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
@@ -672,7 +672,19 @@ impl ConstraintSet for ContactSolver {
                 continue;
             }
             for l in 0..LANES {
-                if self.cold[g].count[l] > 0 && self.cold[g].restitution[l] > 0.0 {
+                // Only lanes with a point that bounces (restitution_one's own test, read
+                // from the lanes: unpacking a lane costs more than its restitution row).
+                let (cold, w) = (&self.cold[g], &self.wide[g]);
+                let count = (cold.count[l] as usize).min(2);
+                let any = w.points[..count].iter().any(|p| {
+                    bounces(
+                        cold.restitution[l],
+                        cold.restitution_threshold[l],
+                        p.approach.0[l],
+                        p.max_normal_impulse.0[l],
+                    )
+                });
+                if any {
                     let mut cc = contact_wide::unpack_full(&self.head[g], &self.wide[g], &self.cold[g], l);
                     restitution_one(&mut cc, states);
                     contact_wide::pack_state(&mut self.head[g], &mut self.wide[g], l, &cc);

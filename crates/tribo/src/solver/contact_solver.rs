@@ -37,8 +37,8 @@
 //! compresses. Here the soft row relaxes towards a *preload* `λ_pre` instead of towards 0:
 //! `Δλ = −m·s_m·(v + β·C) − s_i·(λ − λ_pre)`. The preload is seeded once, when a point
 //! begins — by the warm-start estimate of a new resting contact, or by the load the point
-//! takes in its first step — and then kept while the point stays loaded (a step without
-//! load clears it), so a steady load needs no deflection while impacts and later load
+//! takes in its first step — and then kept while the point keeps at least half that load
+//! (a step with less clears it, [`next_preload`]), so a steady load needs no deflection while impacts and later load
 //! changes still meet the damped spring (a load added on top deflects it as in Box2D). It is deliberately not tracked afterwards: a preload that followed the load
 //! (even at 0.2 % of the gap per step) is an integrator around the chain of springs of a
 //! stack, and it kept the 100-row benchmark pyramid swaying at 0.05–0.25 m/s. Each point has
@@ -678,6 +678,37 @@ const ESTIMATE_TOLERANCE: f32 = 1e-4;
 /// Approach speed [m/s] below which a new touching contact counts as resting.
 const RESTING_SPEED: f32 = 0.5;
 
+/// The preload a point carries into the next step (module docs): seeded by a new point's
+/// load (unless the point bounced: its impulse then holds the restitution kick, not a
+/// load), then kept while the point's load stays at least half of it; a step without load,
+/// or with less than half, clears it for good (re-seeding contacts whose load flickers,
+/// such as the side contacts of a pyramid's rows, kicked the pyramid into swaying).
+///
+/// Why both guards: a preload the contact does not carry keeps pushing the bodies apart,
+/// at about s_i·λ_pre / (s_m·m) per substep once they separate. In Box2D's spinner with
+/// μs = 1.5 μd, bodies the rotor had pressed into the wall kept 40–50 N·s preloads after
+/// the squeeze (25 m/s of push on a 0.1 kg body); and points that began in an impact were
+/// seeded with their bounce impulse, whose push made the next impacts, whose bounces seeded
+/// the next preloads: the pile blew up within 70 steps. A steady load stays within a few
+/// percent of its preload, so stacks keep theirs.
+pub(crate) fn next_preload(preload: f32, normal: f32, max_normal: f32, fresh: bool, bounced: bool) -> f32 {
+    if max_normal <= 0.0 || (fresh && bounced) {
+        0.0
+    } else if fresh {
+        normal
+    } else if normal < 0.5 * preload {
+        0.0
+    } else {
+        preload
+    }
+}
+
+/// Whether the restitution pass gave a point a bounce ([`restitution_one`]'s test).
+#[inline]
+pub(crate) fn bounces(restitution: f32, threshold: f32, approach: f32, max_normal: f32) -> bool {
+    restitution > 0.0 && approach <= -threshold && max_normal > 0.0
+}
+
 /// Mass ratio above which a light body's constraints get extra local sweeps.
 pub(crate) const MASS_RATIO_GROUP: f32 = 4.0;
 
@@ -817,7 +848,14 @@ pub(crate) fn restitution_one<S: StateCell>(cc: &mut ContactConstraint, states: 
     }
     let (mut a, mut b) = load(states, cc.index_a, cc.index_b);
     let n = cc.normal;
-    let bounces = |p: &ConstraintPoint| p.approach <= -cc.restitution_threshold && p.max_normal_impulse > 0.0;
+    let bounces = |p: &ConstraintPoint| {
+        bounces(
+            cc.restitution,
+            cc.restitution_threshold,
+            p.approach,
+            p.max_normal_impulse,
+        )
+    };
     if cc.count == 2 && cc.block && bounces(&cc.points[0]) && bounces(&cc.points[1]) {
         // Both points of a face bounce: solve them together, or the second point's
         // impulse would add to the rebound the first already set (energy gain).
@@ -1090,16 +1128,13 @@ pub(crate) fn store_impulses<S: StateRead>(
         };
         ps.max_normal_impulse = cp.max_normal_impulse;
         ps.approach_velocity = cp.approach;
-        // Preload (module docs): seeded by a new point's load, then kept; a step without
-        // load clears it for good (re-seeding contacts whose load flickers, such as the
-        // side contacts of a pyramid's rows, kicked the pyramid into swaying).
-        ps.preload = if cp.max_normal_impulse <= 0.0 {
-            0.0
-        } else if cp.fresh {
-            cp.normal_impulse
-        } else {
-            cp.preload
-        };
+        let bounced = bounces(
+            cc.restitution,
+            cc.restitution_threshold,
+            cp.approach,
+            cp.max_normal_impulse,
+        );
+        ps.preload = next_preload(cp.preload, cp.normal_impulse, cp.max_normal_impulse, cp.fresh, bounced);
         ps.fresh = false;
         let vt = point_velocity(cc, &a, &b, cp.r_a, cp.r_b).dot(t) - cc.tangent_speed;
         ps.slip_speed = vt.abs();

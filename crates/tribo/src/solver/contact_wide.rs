@@ -27,8 +27,8 @@
 //! operations, so a contact solved wide or scalar gets the same numbers.
 
 use super::contact_solver::{
-    fresh_point_sticks, kinetic_energy_of, ConstraintBodies, ConstraintPoint, ContactConstraint, ContactInput,
-    StepSoftness,
+    bounces, fresh_point_sticks, kinetic_energy_of, next_preload, ConstraintBodies, ConstraintPoint, ContactConstraint,
+    ContactInput, StepSoftness,
 };
 use super::wide::{F4, LANES, M4, V4};
 use super::Softness;
@@ -654,13 +654,18 @@ pub(crate) fn store_group<S: StateRead>(
                     0.0
                 },
                 slip_speed,
-                preload: if max <= 0.0 {
-                    0.0
-                } else if fresh {
-                    normal
-                } else {
-                    wp.preload.0[l]
-                },
+                preload: next_preload(
+                    wp.preload.0[l],
+                    normal,
+                    max,
+                    fresh,
+                    bounces(
+                        cold.restitution[l],
+                        cold.restitution_threshold[l],
+                        wp.approach.0[l],
+                        max,
+                    ),
+                ),
                 approach_velocity: wp.approach.0[l],
             };
         }

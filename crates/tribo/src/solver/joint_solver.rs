@@ -124,7 +124,12 @@ impl JointConstraint {
             frame_a: a.q.rotate(d.local_anchor_a - a.local_center),
             frame_b: b.q.rotate(d.local_anchor_b - b.local_center),
             delta_center: b.center - a.center,
-            angle0: joint_angle(a.q, b.q, d.reference_angle),
+            // Only the limit and the spring read the angle (an atan2 per joint and step).
+            angle0: if d.enable_limit || d.enable_spring {
+                joint_angle(a.q, b.q, d.reference_angle)
+            } else {
+                0.0
+            },
             axial_mass: if k > 0.0 { 1.0 / k } else { 0.0 },
             softness: Softness::new(hertz, d.constraint_damping_ratio, ctx.h),
             spring: Softness::new(d.spring_hertz, d.spring_damping_ratio, ctx.h),
