@@ -6,7 +6,7 @@
 
 use crate::dynamics::MixedMaterial;
 use crate::geometry::LINEAR_SLOP;
-use crate::geometry::{collide_after, Manifold, Shape, MAX_MANIFOLD_POINTS};
+use crate::geometry::{collide_bounded, Manifold, Shape, MAX_MANIFOLD_POINTS};
 use crate::math::{Rot, Transform, Vec2};
 use crate::world::ShapeId;
 
@@ -75,6 +75,19 @@ pub(crate) struct Contact {
     pub shape_b: ShapeId,
     /// Where the manifold was last computed, for recycling it.
     pub basis: RecycleBasis,
+    /// For a pair found apart: a lower bound [m] on its surfaces' distance at the poses of
+    /// `far` (0: none). See [`Contact::still_apart`].
+    pub far_bound: f32,
+    pub far: FarPoses,
+}
+
+/// The bodies' poses when [`Contact::far_bound`] was computed.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct FarPoses {
+    /// Origin of B minus origin of A [m].
+    pub d: Vec2,
+    pub q_a: Rot,
+    pub q_b: Rot,
 }
 
 /// The narrow phase's verdict on one contact in one step.
@@ -130,7 +143,9 @@ impl Contact {
     ) -> bool {
         let old_manifold = self.manifold;
         let old_points = self.points;
-        self.manifold = collide_after(geom_a, xf_a, geom_b, xf_b, speculative_distance, &old_manifold);
+        let (manifold, bound) = collide_bounded(geom_a, xf_a, geom_b, xf_b, speculative_distance, &old_manifold);
+        self.manifold = manifold;
+        self.far_bound = bound;
         for i in 0..self.manifold.count {
             let id = self.manifold.points[i].id;
             let matched = (0..old_manifold.count).find(|&j| old_manifold.points[j].id == id);
@@ -169,6 +184,25 @@ impl Contact {
         self.basis.rel_q = xf_a.q.inv_mul(xf_b.q);
         self.basis.normal_a = xf_a.q.inv_rotate(n);
         self.touching
+    }
+
+    /// Whether a pair found apart is still too far apart for any manifold point within
+    /// `margin` [m], judged without colliding it: its distance bound minus the most its
+    /// surfaces can have closed in since, the relative motion of the body origins plus each
+    /// body's turn times its reach (a point at distance R from the origin turning by Δθ moves
+    /// 2R·sin(Δθ/2) = R·|q − q₀|, exactly). `d`: origin of B minus origin of A now [m];
+    /// `reach_a`, `reach_b`: the bodies' largest distance [m] from their origin to a shape
+    /// point. When true, colliding would give the empty manifold the contact already has
+    /// (see `geometry::collide_bounded`).
+    #[inline]
+    pub fn still_apart(&self, d: Vec2, q_a: Rot, q_b: Rot, reach_a: f32, reach_b: f32, margin: f32) -> bool {
+        if self.touching || self.far_bound <= margin {
+            return false;
+        }
+        let f = &self.far;
+        let turn = |q: Rot, q0: Rot| ((q.c - q0.c) * (q.c - q0.c) + (q.s - q0.s) * (q.s - q0.s)).sqrt();
+        let closed = (d - f.d).length() + reach_a * turn(q_a, f.q_a) + reach_b * turn(q_b, f.q_b);
+        self.far_bound - closed > margin
     }
 
     /// What [`Contact::update`] leaves when the shapes are too far apart for any point:
@@ -256,6 +290,8 @@ pub(crate) fn blank_contact() -> Contact {
         rolling_impulse: 0.0,
         touching: false,
         basis: RecycleBasis::default(),
+        far_bound: 0.0,
+        far: FarPoses::default(),
     }
 }
 
@@ -333,5 +369,47 @@ mod tests {
         assert!(!b.clone().recycle(xf_g, tipped, 2.0 * 0.71));
         // And the untouched pair is recycled (the test would prove nothing otherwise).
         assert!(b.recycle(xf_g, Transform::new(Vec2::new(0.0, 0.5), 0.0), 2.0 * 0.71));
+    }
+
+    #[test]
+    fn a_pair_judged_still_apart_has_no_manifold_point() {
+        // A box turning and drifting towards another along a wobbly path, 0.5 mm to 3 cm per
+        // step: every step the contact either is judged still apart (its bound minus the
+        // motion since exceeds the margin) or is collided. Whenever it is judged apart, a
+        // fresh collide at that pose must be empty, and the pair must end up collided and
+        // touching (the skip never hides the approach).
+        use crate::geometry::collide;
+        let a_shape = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
+        let b_shape = Shape::Polygon(Polygon::new_box(0.3, 0.2).unwrap());
+        let reach_a = a_shape.max_extent(Vec2::ZERO);
+        let reach_b = b_shape.max_extent(Vec2::ZERO);
+        let mut c = blank_contact();
+        let margin = 0.02;
+        let (mut skipped, mut touched) = (0, false);
+        for k in 0..400 {
+            let t = k as f32;
+            let xf_a = Transform::new(Vec2::new(0.0, 0.01 * (0.3 * t).sin()), 0.002 * t);
+            let gap = 2.0 - 0.005 * t;
+            let xf_b = Transform::new(Vec2::new(gap, 0.3 * (0.05 * t).sin()), 0.01 * t);
+            let d = xf_b.p - xf_a.p;
+            if c.still_apart(d, xf_a.q, xf_b.q, reach_a, reach_b, margin) {
+                skipped += 1;
+                assert_eq!(collide(&a_shape, xf_a, &b_shape, xf_b, margin).count, 0, "step {k}");
+                continue;
+            }
+            if c.update(&a_shape, xf_a, &b_shape, xf_b, margin) {
+                touched = true;
+                break;
+            }
+            if c.far_bound > 0.0 {
+                c.far = FarPoses {
+                    d,
+                    q_a: xf_a.q,
+                    q_b: xf_b.q,
+                };
+            }
+        }
+        assert!(touched, "the boxes never touched");
+        assert!(skipped > 100, "only {skipped} steps skipped");
     }
 }

@@ -16,6 +16,7 @@ mod raycast;
 mod shapes;
 
 pub use hull::convex_hull;
+pub(crate) use manifold::collide_bounded;
 pub use manifold::{collide, collide_after, Manifold, ManifoldPoint, MAX_MANIFOLD_POINTS};
 pub use mass::MassData;
 pub use raycast::{RayCastInput, RayHit};

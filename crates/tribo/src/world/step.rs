@@ -8,7 +8,7 @@
 
 use super::{ContactBeginEvent, ContactEndEvent, Stopwatch, World};
 use crate::collision::broad_phase::{MOVING_TREE, STATIC_TREE};
-use crate::collision::contact::{pair_key, Contact, NarrowOutcome, PointState};
+use crate::collision::contact::{pair_key, Contact, FarPoses, NarrowOutcome, PointState};
 use crate::dynamics::body::Body;
 use crate::dynamics::shape::ShapeRecord;
 use crate::dynamics::{mix, BodyType};
@@ -178,6 +178,8 @@ impl World {
             rolling_impulse: 0.0,
             touching: false,
             basis: Default::default(),
+            far_bound: 0.0,
+            far: Default::default(),
         };
         let (body_a, body_b) = (contact.body_a, contact.body_b);
         let ci = match self.contact_free.pop() {
@@ -722,8 +724,27 @@ fn narrow_phase(c: &mut Contact, bodies: &Arena<Body>, shapes: &Arena<ShapeRecor
             changed: was,
         };
     }
+    // A pair found apart that cannot have closed the gap since: its manifold stays empty.
+    let (d, reach_a, reach_b) = (
+        bb.xf.p - ba.xf.p,
+        ba.max_extent + ba.local_center.length(),
+        bb.max_extent + bb.local_center.length(),
+    );
+    if c.still_apart(d, ba.xf.q, bb.xf.q, reach_a, reach_b, margin) {
+        return NarrowOutcome::Updated {
+            touching: false,
+            changed: false,
+        };
+    }
     let now = c.recycle(ba.xf, bb.xf, 2.0 * ba.max_extent.min(bb.max_extent))
         || c.update(&sa.geometry, ba.xf, &sb.geometry, bb.xf, margin);
+    if !now && c.far_bound > 0.0 {
+        c.far = FarPoses {
+            d,
+            q_a: ba.xf.q,
+            q_b: bb.xf.q,
+        };
+    }
     NarrowOutcome::Updated {
         touching: now,
         changed: now != was,

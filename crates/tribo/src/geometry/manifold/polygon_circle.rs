@@ -13,14 +13,22 @@ use super::{closest_on_segment, LocalManifold, Manifold};
 use crate::geometry::{Circle, Polygon};
 use crate::math::Transform;
 
-/// Contact between polygon `a` (placed by `xf_a`) and circle `b` (placed by `xf_b`).
-pub(super) fn collide_polygon_circle(a: &Polygon, xf_a: Transform, b: &Circle, xf_b: Transform, spec: f32) -> Manifold {
+/// Contact between polygon `a` (placed by `xf_a`) and circle `b` (placed by `xf_b`), and
+/// the separation bound of an empty manifold (see `collide_bounded`): `s − radii` when `s`
+/// rejected the pair.
+pub(super) fn collide_polygon_circle_bounded(
+    a: &Polygon,
+    xf_a: Transform,
+    b: &Circle,
+    xf_b: Transform,
+    spec: f32,
+) -> (Manifold, f32) {
     let c = xf_a.inv_mul(xf_b).apply(b.center);
     let verts = a.vertices();
     let normals = a.normals();
     let n = verts.len();
     if n < 2 {
-        return Manifold::EMPTY;
+        return (Manifold::EMPTY, 0.0);
     }
     let radius = a.radius() + b.radius;
 
@@ -34,7 +42,8 @@ pub(super) fn collide_polygon_circle(a: &Polygon, xf_a: Transform, b: &Circle, x
         }
     }
     if !(best - radius < spec) {
-        return Manifold::EMPTY;
+        let bound = best - radius;
+        return (Manifold::EMPTY, if bound > 0.0 { bound } else { 0.0 });
     }
 
     let (normal, q, core_distance) = if best <= 0.0 {
@@ -61,7 +70,7 @@ pub(super) fn collide_polygon_circle(a: &Polygon, xf_a: Transform, b: &Circle, x
     let mut m = LocalManifold::new(normal);
     let point = (q + normal * a.radius() + c - normal * b.radius) * 0.5;
     m.push(point, core_distance - radius, 0, spec);
-    m.to_world(xf_a, xf_b)
+    (m.to_world(xf_a, xf_b), 0.0)
 }
 
 #[cfg(test)]

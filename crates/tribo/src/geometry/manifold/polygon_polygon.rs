@@ -116,7 +116,12 @@ pub(super) fn collide_polygons_local(
     let (edge_a, sep_a) = max_separation(a, b);
     let (edge_b, sep_b) = max_separation(b, a);
     if !(sep_a <= spec + radius && sep_b <= spec + radius) {
-        return empty;
+        // A separating axis: the cores are at least this far apart (NaN gives no bound).
+        let bound = sep_a.max(sep_b) - radius;
+        return LocalManifold {
+            bound: if bound > 0.0 { bound } else { 0.0 },
+            ..empty
+        };
     }
 
     // Keeping the last reference only makes sense for two nearly parallel faces (either
@@ -201,19 +206,21 @@ pub(super) fn collide_polygons_local(
     }
 }
 
-/// Contact between polygons `a` (placed by `xf_a`) and `b` (placed by `xf_b`);
-/// `last_reference_b` as in [`collide_polygons_local`].
-pub(super) fn collide_polygons(
+/// Contact between polygons `a` (placed by `xf_a`) and `b` (placed by `xf_b`), and the
+/// separation bound of an empty manifold (see `collide_bounded`); `last_reference_b` as in
+/// [`collide_polygons_local`].
+pub(super) fn collide_polygons_bounded(
     a: &Polygon,
     xf_a: Transform,
     b: &Polygon,
     xf_b: Transform,
     spec: f32,
     last_reference_b: Option<bool>,
-) -> Manifold {
+) -> (Manifold, f32) {
     let la = LocalPoly::from_polygon(a, Transform::IDENTITY);
     let lb = LocalPoly::from_polygon(b, xf_a.inv_mul(xf_b));
-    collide_polygons_local(&la, &lb, spec, last_reference_b).to_world(xf_a, xf_b)
+    let m = collide_polygons_local(&la, &lb, spec, last_reference_b);
+    (m.to_world(xf_a, xf_b), m.bound)
 }
 
 #[cfg(test)]
