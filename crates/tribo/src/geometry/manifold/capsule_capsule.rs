@@ -84,7 +84,11 @@ pub(super) fn capsules_local(a1: Vec2, a2: Vec2, ra: f32, b1: Vec2, b2: Vec2, rb
     let delta = c.b - c.a;
     let dist = delta.length();
     if !(dist - radius < spec) {
-        return LocalManifold::default();
+        // The closest points: the exact distance.
+        return LocalManifold {
+            bound: if dist - radius > 0.0 { dist - radius } else { 0.0 },
+            ..LocalManifold::default()
+        };
     }
     if !(dist > CORE_TOUCH) {
         let pa = LocalPoly::from_segment(a1, a2, ra);
@@ -123,7 +127,13 @@ pub(super) fn capsules_local(a1: Vec2, a2: Vec2, ra: f32, b1: Vec2, b2: Vec2, rb
 }
 
 /// Contact between capsules `a` (placed by `xf_a`) and `b` (placed by `xf_b`).
-pub(super) fn collide_capsules(a: &Capsule, xf_a: Transform, b: &Capsule, xf_b: Transform, spec: f32) -> Manifold {
+pub(super) fn collide_capsules(
+    a: &Capsule,
+    xf_a: Transform,
+    b: &Capsule,
+    xf_b: Transform,
+    spec: f32,
+) -> (Manifold, f32) {
     let rel = xf_a.inv_mul(xf_b);
     capsules_local(
         a.center1,

@@ -20,12 +20,18 @@ pub(super) fn capsule_circle_local(p1: Vec2, p2: Vec2, ra: f32, c: Vec2, rb: f32
     };
     let mut m = LocalManifold::new(normal);
     let point = (q + normal * ra + c - normal * rb) * 0.5;
-    m.push(point, dist - ra - rb, 0, spec);
+    m.push_or_bound(point, dist - ra - rb, 0, spec);
     m
 }
 
 /// Contact between capsule `a` (placed by `xf_a`) and circle `b` (placed by `xf_b`).
-pub(super) fn collide_capsule_circle(a: &Capsule, xf_a: Transform, b: &Circle, xf_b: Transform, spec: f32) -> Manifold {
+pub(super) fn collide_capsule_circle(
+    a: &Capsule,
+    xf_a: Transform,
+    b: &Circle,
+    xf_b: Transform,
+    spec: f32,
+) -> (Manifold, f32) {
     let c = xf_a.inv_mul(xf_b).apply(b.center);
     capsule_circle_local(a.center1, a.center2, a.radius, c, b.radius, spec).to_world(xf_a, xf_b)
 }

@@ -15,28 +15,16 @@ pub(super) fn circles_local(ca: Vec2, ra: f32, cb: Vec2, rb: f32, spec: f32) -> 
     let separation = dist - ra - rb;
     let mut m = LocalManifold::new(normal);
     let point = (ca + normal * ra + cb - normal * rb) * 0.5;
-    m.push(point, separation, 0, spec);
+    m.push_or_bound(point, separation, 0, spec);
     m
 }
 
 /// Contact between circles `a` (placed by `xf_a`) and `b` (placed by `xf_b`), and the
 /// separation bound of an empty manifold: the exact surface distance (see
 /// `collide_bounded`).
-pub(super) fn collide_circles_bounded(
-    a: &Circle,
-    xf_a: Transform,
-    b: &Circle,
-    xf_b: Transform,
-    spec: f32,
-) -> (Manifold, f32) {
+pub(super) fn collide_circles(a: &Circle, xf_a: Transform, b: &Circle, xf_b: Transform, spec: f32) -> (Manifold, f32) {
     let cb = xf_a.inv_mul(xf_b).apply(b.center);
-    let m = circles_local(a.center, a.radius, cb, b.radius, spec);
-    let bound = if m.count == 0 {
-        ((cb - a.center).length() - a.radius - b.radius).max(0.0)
-    } else {
-        0.0
-    };
-    (m.to_world(xf_a, xf_b), bound)
+    circles_local(a.center, a.radius, cb, b.radius, spec).to_world(xf_a, xf_b)
 }
 
 #[cfg(test)]

@@ -14,7 +14,7 @@ pub(super) fn collide_polygon_capsule(
     b: &Capsule,
     xf_b: Transform,
     spec: f32,
-) -> Manifold {
+) -> (Manifold, f32) {
     let rel = xf_a.inv_mul(xf_b);
     let pa = LocalPoly::from_polygon(a, Transform::IDENTITY);
     let pb = LocalPoly::from_segment(rel.apply(b.center1), rel.apply(b.center2), b.radius);

@@ -16,7 +16,7 @@ use crate::math::Transform;
 /// Contact between polygon `a` (placed by `xf_a`) and circle `b` (placed by `xf_b`), and
 /// the separation bound of an empty manifold (see `collide_bounded`): `s − radii` when `s`
 /// rejected the pair.
-pub(super) fn collide_polygon_circle_bounded(
+pub(super) fn collide_polygon_circle(
     a: &Polygon,
     xf_a: Transform,
     b: &Circle,
@@ -70,7 +70,7 @@ pub(super) fn collide_polygon_circle_bounded(
     let mut m = LocalManifold::new(normal);
     let point = (q + normal * a.radius() + c - normal * b.radius) * 0.5;
     m.push(point, core_distance - radius, 0, spec);
-    (m.to_world(xf_a, xf_b), 0.0)
+    m.to_world(xf_a, xf_b)
 }
 
 #[cfg(test)]

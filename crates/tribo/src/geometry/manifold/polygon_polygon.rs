@@ -209,7 +209,7 @@ pub(super) fn collide_polygons_local(
 /// Contact between polygons `a` (placed by `xf_a`) and `b` (placed by `xf_b`), and the
 /// separation bound of an empty manifold (see `collide_bounded`); `last_reference_b` as in
 /// [`collide_polygons_local`].
-pub(super) fn collide_polygons_bounded(
+pub(super) fn collide_polygons(
     a: &Polygon,
     xf_a: Transform,
     b: &Polygon,
@@ -219,8 +219,7 @@ pub(super) fn collide_polygons_bounded(
 ) -> (Manifold, f32) {
     let la = LocalPoly::from_polygon(a, Transform::IDENTITY);
     let lb = LocalPoly::from_polygon(b, xf_a.inv_mul(xf_b));
-    let m = collide_polygons_local(&la, &lb, spec, last_reference_b);
-    (m.to_world(xf_a, xf_b), m.bound)
+    collide_polygons_local(&la, &lb, spec, last_reference_b).to_world(xf_a, xf_b)
 }
 
 #[cfg(test)]

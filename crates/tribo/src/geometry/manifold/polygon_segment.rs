@@ -13,7 +13,7 @@ pub(super) fn collide_polygon_segment(
     b: &Segment,
     xf_b: Transform,
     spec: f32,
-) -> Manifold {
+) -> (Manifold, f32) {
     let rel = xf_a.inv_mul(xf_b);
     let pa = LocalPoly::from_polygon(a, Transform::IDENTITY);
     let pb = LocalPoly::from_segment(rel.apply(b.point1), rel.apply(b.point2), 0.0);

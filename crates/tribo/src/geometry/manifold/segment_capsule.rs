@@ -13,7 +13,7 @@ pub(super) fn collide_segment_capsule(
     b: &Capsule,
     xf_b: Transform,
     spec: f32,
-) -> Manifold {
+) -> (Manifold, f32) {
     let rel = xf_a.inv_mul(xf_b);
     capsules_local(
         a.point1,

@@ -7,7 +7,13 @@ use crate::geometry::{Circle, Segment};
 use crate::math::Transform;
 
 /// Contact between segment `a` (placed by `xf_a`) and circle `b` (placed by `xf_b`).
-pub(super) fn collide_segment_circle(a: &Segment, xf_a: Transform, b: &Circle, xf_b: Transform, spec: f32) -> Manifold {
+pub(super) fn collide_segment_circle(
+    a: &Segment,
+    xf_a: Transform,
+    b: &Circle,
+    xf_b: Transform,
+    spec: f32,
+) -> (Manifold, f32) {
     let c = xf_a.inv_mul(xf_b).apply(b.center);
     capsule_circle_local(a.point1, a.point2, 0.0, c, b.radius, spec).to_world(xf_a, xf_b)
 }
