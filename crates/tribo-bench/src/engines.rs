@@ -95,6 +95,13 @@ pub trait Sim {
     fn awake_count(&mut self) -> usize;
     /// Sets a kinematic body's velocity [m/s] and angular velocity [rad/s] (scene hooks).
     fn set_kinematic_velocity(&mut self, i: usize, v: [f32; 2], w: f32) -> Result<(), BoxError>;
+    /// Adds the bodies and joints of `batch` (joints refer to the batch's own bodies; its
+    /// world settings are not used) under `tag` (scene hooks that create bodies).
+    fn spawn(&mut self, tag: usize, batch: &SceneFile) -> Result<(), BoxError>;
+    /// Destroys the bodies spawned under `tag`, with their shapes and joints.
+    fn despawn(&mut self, tag: usize) -> Result<(), BoxError>;
+    /// Origins of the bodies spawned under `tag`, in batch order (empty if none).
+    fn spawned_positions(&mut self, tag: usize) -> Vec<[f32; 2]>;
     /// Called after each timed step when `--profile` is on.
     fn profile_sample(&mut self) {}
     /// Per-stage profile of the sampled steps, if the engine has one.
@@ -119,8 +126,8 @@ fn shape_field<T: Copy>(v: Option<T>, what: &str, s: &ShapeSpec) -> Result<T, Bo
 }
 
 /// A scene joint as the peers build it: body indices, the anchor in each body's frame
-/// (relative to the body origin) [m], and B's initial rotation relative to A [rad] (the
-/// joint angle is 0 there).
+/// (relative to the body origin) [m], and B's rotation relative to A [rad] at which the
+/// joint angle is 0 (the scene's `reference_angle`, by default the initial one).
 struct JointGeometry {
     a: usize,
     b: usize,
@@ -143,7 +150,9 @@ fn joint_geometry(scene: &SceneFile, j: &JointSpec) -> Result<JointGeometry, Box
         b,
         local_a: local(a),
         local_b: local(b),
-        relative_angle: scene.bodies[b].angle - scene.bodies[a].angle,
+        relative_angle: j
+            .reference_angle
+            .unwrap_or(scene.bodies[b].angle - scene.bodies[a].angle),
     })
 }
 
@@ -155,6 +164,8 @@ mod tribo_sim {
     pub struct TriboSim {
         world: World,
         bodies: Vec<BodyId>,
+        /// Bodies added by hooks, by tag.
+        spawned: std::collections::BTreeMap<usize, Vec<BodyId>>,
         dt: f32,
         profile: ProfileSum,
     }
@@ -181,6 +192,7 @@ mod tribo_sim {
             Ok(TriboSim {
                 world: built.world,
                 bodies: built.bodies,
+                spawned: Default::default(),
                 dt: built.dt,
                 profile: ProfileSum::default(),
             })
@@ -229,9 +241,27 @@ mod tribo_sim {
             self.world.set_body_angular_velocity(id, w)?;
             Ok(())
         }
+        fn spawn(&mut self, tag: usize, batch: &SceneFile) -> Result<(), BoxError> {
+            let ids = batch.add_to(&mut self.world).map_err(|e| e.to_string())?;
+            self.spawned.entry(tag).or_default().extend(ids);
+            Ok(())
+        }
+        fn despawn(&mut self, tag: usize) -> Result<(), BoxError> {
+            for id in self.spawned.remove(&tag).unwrap_or_default() {
+                self.world.destroy_body(id)?;
+            }
+            Ok(())
+        }
+        fn spawned_positions(&mut self, tag: usize) -> Vec<[f32; 2]> {
+            let ids = self.spawned.get(&tag).map(Vec::as_slice).unwrap_or_default();
+            ids.iter()
+                .map(|&id| self.world.body_position(id).map(arr).unwrap_or([f32::NAN; 2]))
+                .collect()
+        }
         fn awake_count(&mut self) -> usize {
             self.bodies
                 .iter()
+                .chain(self.spawned.values().flatten())
                 .filter(|&&id| {
                     self.world
                         .body_type(id)
@@ -275,8 +305,11 @@ mod box2d_sim {
     };
 
     pub struct Box2dSim {
+        foundation: &'static Foundation,
         world: World,
         bodies: Vec<BodyId>,
+        /// Bodies added by hooks, by tag.
+        spawned: std::collections::BTreeMap<usize, Vec<BodyId>>,
         /// Constant forces/torques (Box2D clears applied forces after each step).
         forces: Vec<(BodyId, Vec2, f32)>,
         dt: f32,
@@ -298,119 +331,12 @@ mod box2d_sim {
                 .worker_count(WorkerCount::new(threads as u32)?)
                 .build()?;
             let mut world = foundation.create_world(def)?;
-            let mut bodies = Vec::with_capacity(scene.bodies.len());
-            let mut forces = Vec::new();
-            for b in &scene.bodies {
-                let body_type = match b.kind {
-                    BodyKind::Static => BodyType::Static,
-                    BodyKind::Kinematic => BodyType::Kinematic,
-                    BodyKind::Dynamic => BodyType::Dynamic,
-                };
-                let mut builder = BodyBuilder::from(foundation.body_def())
-                    .body_type(body_type)
-                    .position(Position::new(b.position[0], b.position[1]))
-                    .angle(b.angle)
-                    .awake(b.awake);
-                if b.kind != BodyKind::Static {
-                    builder = builder
-                        .linear_velocity(v(b.linear_velocity))
-                        .angular_velocity(b.angular_velocity)
-                        .linear_damping(b.linear_damping)
-                        .angular_damping(b.angular_damping)
-                        .gravity_scale(b.gravity_scale)
-                        .motion_locks(MotionLocks::new(false, false, b.fixed_rotation));
-                }
-                let id = world.create_body(builder.build()?)?;
-                {
-                    let mut body = world.body(id)?;
-                    for s in &b.shapes {
-                        let m = scene.shape_material(s);
-                        let material = SurfaceMaterial::new()
-                            .with_friction(m.friction_static)?
-                            .with_restitution(m.restitution)?
-                            .with_rolling_resistance(m.rolling_resistance)?
-                            .with_tangent_speed(m.tangent_speed)?;
-                        let f = s.filter.map(tribo::Filter::from).unwrap_or_default();
-                        let filter = Filter {
-                            category_bits: f.category,
-                            mask_bits: f.mask,
-                            group_index: f.group,
-                        };
-                        let def = ShapeDef::builder()
-                            .material(material)
-                            .density(m.density)
-                            .filter(filter)
-                            .build()?;
-                        match s.kind.as_str() {
-                            "circle" => {
-                                let c = s.center.unwrap_or([0.0, 0.0]);
-                                let r = shape_field(s.radius, "radius", s)?;
-                                body.create_circle(&def, &shapes::circle(v(c), r)?)?;
-                            }
-                            "box" => {
-                                let h = shape_field(s.half_extents, "half_extents", s)?;
-                                let c = s.center.unwrap_or([0.0, 0.0]);
-                                let a = s.angle.unwrap_or(0.0);
-                                let poly = if c == [0.0, 0.0] && a == 0.0 {
-                                    shapes::box_polygon(h[0], h[1])?
-                                } else {
-                                    shapes::offset_box_polygon(h[0], h[1], Transform::from_pos_angle(v(c), a)?)?
-                                };
-                                body.create_polygon(&def, &poly)?;
-                            }
-                            "polygon" => {
-                                let pts = s.vertices.as_ref().ok_or("a polygon needs \"vertices\"")?;
-                                let poly =
-                                    shapes::polygon_from_points(pts.iter().map(|&p| v(p)), s.radius.unwrap_or(0.0))?;
-                                body.create_polygon(&def, &poly)?;
-                            }
-                            "capsule" => {
-                                let c1 = shape_field(s.center1, "center1", s)?;
-                                let c2 = shape_field(s.center2, "center2", s)?;
-                                let r = shape_field(s.radius, "radius", s)?;
-                                body.create_capsule(&def, &shapes::capsule(v(c1), v(c2), r)?)?;
-                            }
-                            "segment" => {
-                                let p1 = shape_field(s.point1, "point1", s)?;
-                                let p2 = shape_field(s.point2, "point2", s)?;
-                                body.create_segment(&def, &shapes::segment(v(p1), v(p2))?)?;
-                            }
-                            other => return Err(format!("unknown shape type {other}").into()),
-                        }
-                    }
-                }
-                if b.kind == BodyKind::Dynamic && (b.force != [0.0, 0.0] || b.torque != 0.0) {
-                    forces.push((id, v(b.force), b.torque));
-                }
-                bodies.push(id);
-            }
-            for j in &scene.joints {
-                let g = joint_geometry(scene, j)?;
-                // Box2D's joint angle is that of frame B relative to frame A: frame B turned by
-                // −(initial relative angle) makes it 0 at the initial poses, as in the scene.
-                let base = world
-                    .joint_base(bodies[g.a], bodies[g.b])?
-                    .with_local_frame_components(v(g.local_a), 0.0, v(g.local_b), -g.relative_angle)?
-                    .with_collide_connected(j.collide_connected)
-                    .with_constraint_tuning(ConstraintTuning::new(j.constraint_hertz, j.constraint_damping_ratio)?);
-                let mut def = RevoluteJointDef::new(base);
-                if let Some([lower, upper]) = j.limit {
-                    def = def.enable_limit(true).lower_angle(lower).upper_angle(upper);
-                }
-                if let Some(m) = j.motor {
-                    def = def
-                        .enable_motor(true)
-                        .motor_speed(m.speed)
-                        .max_motor_torque(m.max_torque);
-                }
-                if let Some(sp) = j.spring {
-                    def = def.enable_spring(true).hertz(sp.hertz).damping_ratio(sp.damping_ratio);
-                }
-                world.create_revolute_joint(&def)?;
-            }
+            let (bodies, forces) = add_scene(foundation, &mut world, scene)?;
             Ok(Box2dSim {
+                foundation,
                 world,
                 bodies,
+                spawned: Default::default(),
                 forces,
                 dt: scene.dt,
                 substeps: scene.substeps as i32,
@@ -418,6 +344,127 @@ mod box2d_sim {
                 profile: ProfileSum::default(),
             })
         }
+    }
+
+    /// Adds a scene's bodies and joints to a Box2D world: the bodies in scene order, and
+    /// the constant forces to apply before every step (Box2D clears applied forces).
+    #[allow(clippy::type_complexity)]
+    fn add_scene(
+        foundation: &Foundation,
+        world: &mut World,
+        scene: &SceneFile,
+    ) -> Result<(Vec<BodyId>, Vec<(BodyId, Vec2, f32)>), BoxError> {
+        let mut bodies = Vec::with_capacity(scene.bodies.len());
+        let mut forces = Vec::new();
+        for b in &scene.bodies {
+            let body_type = match b.kind {
+                BodyKind::Static => BodyType::Static,
+                BodyKind::Kinematic => BodyType::Kinematic,
+                BodyKind::Dynamic => BodyType::Dynamic,
+            };
+            let mut builder = BodyBuilder::from(foundation.body_def())
+                .body_type(body_type)
+                .position(Position::new(b.position[0], b.position[1]))
+                .angle(b.angle)
+                .awake(b.awake);
+            if b.kind != BodyKind::Static {
+                builder = builder
+                    .linear_velocity(v(b.linear_velocity))
+                    .angular_velocity(b.angular_velocity)
+                    .linear_damping(b.linear_damping)
+                    .angular_damping(b.angular_damping)
+                    .gravity_scale(b.gravity_scale)
+                    .motion_locks(MotionLocks::new(false, false, b.fixed_rotation));
+            }
+            let id = world.create_body(builder.build()?)?;
+            {
+                let mut body = world.body(id)?;
+                for s in &b.shapes {
+                    let m = scene.shape_material(s);
+                    let material = SurfaceMaterial::new()
+                        .with_friction(m.friction_static)?
+                        .with_restitution(m.restitution)?
+                        .with_rolling_resistance(m.rolling_resistance)?
+                        .with_tangent_speed(m.tangent_speed)?;
+                    let f = s.filter.map(tribo::Filter::from).unwrap_or_default();
+                    let filter = Filter {
+                        category_bits: f.category,
+                        mask_bits: f.mask,
+                        group_index: f.group,
+                    };
+                    let def = ShapeDef::builder()
+                        .material(material)
+                        .density(m.density)
+                        .filter(filter)
+                        .build()?;
+                    match s.kind.as_str() {
+                        "circle" => {
+                            let c = s.center.unwrap_or([0.0, 0.0]);
+                            let r = shape_field(s.radius, "radius", s)?;
+                            body.create_circle(&def, &shapes::circle(v(c), r)?)?;
+                        }
+                        "box" => {
+                            let h = shape_field(s.half_extents, "half_extents", s)?;
+                            let c = s.center.unwrap_or([0.0, 0.0]);
+                            let a = s.angle.unwrap_or(0.0);
+                            let poly = if c == [0.0, 0.0] && a == 0.0 {
+                                shapes::box_polygon(h[0], h[1])?
+                            } else {
+                                shapes::offset_box_polygon(h[0], h[1], Transform::from_pos_angle(v(c), a)?)?
+                            };
+                            body.create_polygon(&def, &poly)?;
+                        }
+                        "polygon" => {
+                            let pts = s.vertices.as_ref().ok_or("a polygon needs \"vertices\"")?;
+                            let poly = shapes::polygon_from_points(pts.iter().map(|&p| v(p)), s.radius.unwrap_or(0.0))?;
+                            body.create_polygon(&def, &poly)?;
+                        }
+                        "capsule" => {
+                            let c1 = shape_field(s.center1, "center1", s)?;
+                            let c2 = shape_field(s.center2, "center2", s)?;
+                            let r = shape_field(s.radius, "radius", s)?;
+                            body.create_capsule(&def, &shapes::capsule(v(c1), v(c2), r)?)?;
+                        }
+                        "segment" => {
+                            let p1 = shape_field(s.point1, "point1", s)?;
+                            let p2 = shape_field(s.point2, "point2", s)?;
+                            body.create_segment(&def, &shapes::segment(v(p1), v(p2))?)?;
+                        }
+                        other => return Err(format!("unknown shape type {other}").into()),
+                    }
+                }
+            }
+            if b.kind == BodyKind::Dynamic && (b.force != [0.0, 0.0] || b.torque != 0.0) {
+                forces.push((id, v(b.force), b.torque));
+            }
+            bodies.push(id);
+        }
+        for j in &scene.joints {
+            let g = joint_geometry(scene, j)?;
+            // Box2D's joint angle is that of frame B relative to frame A: frame B turned by
+            // −(reference angle: by default the initial relative angle) makes it 0 there, as
+            // in the scene.
+            let base = world
+                .joint_base(bodies[g.a], bodies[g.b])?
+                .with_local_frame_components(v(g.local_a), 0.0, v(g.local_b), -g.relative_angle)?
+                .with_collide_connected(j.collide_connected)
+                .with_constraint_tuning(ConstraintTuning::new(j.constraint_hertz, j.constraint_damping_ratio)?);
+            let mut def = RevoluteJointDef::new(base);
+            if let Some([lower, upper]) = j.limit {
+                def = def.enable_limit(true).lower_angle(lower).upper_angle(upper);
+            }
+            if let Some(m) = j.motor {
+                def = def
+                    .enable_motor(true)
+                    .motor_speed(m.speed)
+                    .max_motor_torque(m.max_torque);
+            }
+            if let Some(sp) = j.spring {
+                def = def.enable_spring(true).hertz(sp.hertz).damping_ratio(sp.damping_ratio);
+            }
+            world.create_revolute_joint(&def)?;
+        }
+        Ok((bodies, forces))
     }
 
     fn profile_fields(p: &Profile) -> [(&'static str, f32); 14] {
@@ -453,6 +500,29 @@ mod box2d_sim {
                 Some(e) => Err(e.into()),
                 None => Ok(()),
             }
+        }
+        fn spawn(&mut self, tag: usize, batch: &SceneFile) -> Result<(), BoxError> {
+            let (ids, forces) = add_scene(self.foundation, &mut self.world, batch)?;
+            if !forces.is_empty() {
+                return Err("box2d: constant forces on spawned bodies are not mapped".into());
+            }
+            self.spawned.entry(tag).or_default().extend(ids);
+            Ok(())
+        }
+        fn despawn(&mut self, tag: usize) -> Result<(), BoxError> {
+            for id in self.spawned.remove(&tag).unwrap_or_default() {
+                self.world.body(id)?.destroy()?;
+            }
+            Ok(())
+        }
+        fn spawned_positions(&mut self, tag: usize) -> Vec<[f32; 2]> {
+            let ids = self.spawned.get(&tag).cloned().unwrap_or_default();
+            ids.iter()
+                .map(|&id| match self.world.body(id).and_then(|b| b.position()) {
+                    Ok(p) => [p.x, p.y],
+                    Err(_) => [f32::NAN; 2],
+                })
+                .collect()
         }
         fn set_kinematic_velocity(&mut self, i: usize, vel: [f32; 2], w: f32) -> Result<(), BoxError> {
             let mut body = self.world.body(self.bodies[i])?;
@@ -515,7 +585,29 @@ mod rapier_sim {
     pub struct RapierSim {
         world: PhysicsWorld,
         bodies: Vec<RigidBodyHandle>,
+        /// Bodies added by hooks, by tag.
+        spawned: std::collections::BTreeMap<usize, Vec<RigidBodyHandle>>,
+        /// Some collider has a filter group ([`GroupHooks`] must run).
+        hooks: bool,
         threads: usize,
+    }
+
+    /// Box2D's group index, which Rapier's interaction groups do not have: colliders with
+    /// a non-zero group carry it in their user data and ask for this contact filter, which
+    /// drops the pairs of one negative group. (Rapier tests the interaction groups before
+    /// the hook, so a positive group cannot override the masks as in Box2D.)
+    struct GroupHooks;
+
+    impl PhysicsHooks for GroupHooks {
+        fn filter_contact_pair(&self, context: &PairFilterContext) -> Option<SolverFlags> {
+            let group = |h: ColliderHandle| context.colliders.get(h).map_or(0, |c| c.user_data as i32);
+            let (a, b) = (group(context.collider1), group(context.collider2));
+            if a == b && a < 0 {
+                None
+            } else {
+                Some(SolverFlags::COMPUTE_RIGID_IMPULSES)
+            }
+        }
     }
 
     fn v(a: [f32; 2]) -> Vector {
@@ -526,12 +618,12 @@ mod rapier_sim {
     /// stiff as Box2D's rigid motor row; the torque bound still limits it.
     const MOTOR_GAIN: f32 = 1.0e9;
 
-    /// A shape's filter as Rapier's interaction groups (32 bits; Rapier has no group
-    /// index, so only group 0 maps).
+    /// A shape's filter as Rapier's interaction groups (32 bits; the group index goes
+    /// through [`GroupHooks`]).
     fn groups(s: &ShapeSpec) -> Result<InteractionGroups, BoxError> {
         let f = s.filter.map(tribo::Filter::from).unwrap_or_default();
-        if f.group != 0 {
-            return Err("rapier: filter groups are not mapped (Rapier has no group index)".into());
+        if f.group > 0 {
+            return Err("rapier: positive filter groups are not mapped (see GroupHooks)".into());
         }
         if f.category > u32::MAX as u64 {
             return Err("rapier: filter categories above bit 31 are not mapped".into());
@@ -541,6 +633,134 @@ mod rapier_sim {
             Group::from_bits_truncate(f.mask as u32),
             InteractionTestMode::And,
         ))
+    }
+
+    /// Adds a scene's bodies and joints to a Rapier world: the bodies in scene order, and
+    /// whether some collider needs [`GroupHooks`].
+    fn add_scene(world: &mut PhysicsWorld, scene: &SceneFile) -> Result<(Vec<RigidBodyHandle>, bool), BoxError> {
+        let mut hooks = false;
+        let mut bodies = Vec::with_capacity(scene.bodies.len());
+        for b in &scene.bodies {
+            let mut builder = match b.kind {
+                BodyKind::Static => RigidBodyBuilder::fixed(),
+                BodyKind::Kinematic => RigidBodyBuilder::kinematic_velocity_based(),
+                BodyKind::Dynamic => RigidBodyBuilder::dynamic(),
+            }
+            .translation(v(b.position))
+            .rotation(b.angle)
+            .can_sleep(scene.enable_sleep);
+            if b.kind != BodyKind::Static {
+                builder = builder
+                    .linvel(v(b.linear_velocity))
+                    .angvel(b.angular_velocity)
+                    .linear_damping(b.linear_damping)
+                    .angular_damping(b.angular_damping)
+                    .gravity_scale(b.gravity_scale);
+                if b.fixed_rotation {
+                    builder = builder.lock_rotations();
+                }
+            }
+            let handle = world.bodies.insert(builder.build());
+            for s in &b.shapes {
+                let m = scene.shape_material(s);
+                let collider = match s.kind.as_str() {
+                    "circle" => ColliderBuilder::ball(shape_field(s.radius, "radius", s)?)
+                        .translation(v(s.center.unwrap_or([0.0, 0.0]))),
+                    "box" => {
+                        let h = shape_field(s.half_extents, "half_extents", s)?;
+                        ColliderBuilder::cuboid(h[0], h[1])
+                            .translation(v(s.center.unwrap_or([0.0, 0.0])))
+                            .rotation(s.angle.unwrap_or(0.0))
+                    }
+                    "polygon" => {
+                        let pts: Vec<Vector> = s
+                            .vertices
+                            .as_ref()
+                            .ok_or("a polygon needs \"vertices\"")?
+                            .iter()
+                            .map(|&p| v(p))
+                            .collect();
+                        let r = s.radius.unwrap_or(0.0);
+                        let c = if r > 0.0 {
+                            ColliderBuilder::round_convex_hull(&pts, r)
+                        } else {
+                            ColliderBuilder::convex_hull(&pts)
+                        };
+                        c.ok_or("rapier: convex hull failed")?
+                    }
+                    "capsule" => ColliderBuilder::capsule_from_endpoints(
+                        v(shape_field(s.center1, "center1", s)?),
+                        v(shape_field(s.center2, "center2", s)?),
+                        shape_field(s.radius, "radius", s)?,
+                    ),
+                    "segment" => ColliderBuilder::segment(
+                        v(shape_field(s.point1, "point1", s)?),
+                        v(shape_field(s.point2, "point2", s)?),
+                    ),
+                    other => return Err(format!("unknown shape type {other}").into()),
+                }
+                .collision_groups(groups(s)?)
+                .user_data(group_of(s) as u32 as u128)
+                .active_hooks(if group_of(s) != 0 {
+                    hooks = true;
+                    ActiveHooks::FILTER_CONTACT_PAIRS
+                } else {
+                    ActiveHooks::empty()
+                })
+                .density(m.density)
+                .friction(m.friction_static)
+                .friction_combine_rule(CoefficientCombineRule::GeometricMean)
+                .restitution(m.restitution)
+                .restitution_combine_rule(CoefficientCombineRule::Max);
+                world.colliders.insert_with_parent(collider, handle, &mut world.bodies);
+            }
+            if b.kind == BodyKind::Dynamic && (b.force != [0.0, 0.0] || b.torque != 0.0) {
+                // Rapier keeps user forces until reset_forces.
+                let rb = &mut world.bodies[handle];
+                rb.add_force(v(b.force), false);
+                rb.add_torque(b.torque, false);
+            }
+            bodies.push(handle);
+        }
+        for j in &scene.joints {
+            let g = joint_geometry(scene, j)?;
+            let mut joint = RevoluteJointBuilder::new()
+                .local_anchor1(v(g.local_a))
+                .local_anchor2(v(g.local_b))
+                .contacts_enabled(j.collide_connected)
+                .softness(SpringCoefficients::new(j.constraint_hertz, j.constraint_damping_ratio));
+            if let Some([lower, upper]) = j.limit {
+                joint = joint.limits([lower, upper]);
+            }
+            if let Some(sp) = j.spring {
+                // Rapier's joint has one motor: a spring takes it (acceleration-based, so the
+                // stiffness ω² and damping 2ζω do not depend on the masses, as Box2D's
+                // spring), and a friction motor beside it is dropped.
+                let omega = 2.0 * std::f32::consts::PI * sp.hertz;
+                joint = joint.motor_model(MotorModel::AccelerationBased).motor_position(
+                    0.0,
+                    omega * omega,
+                    2.0 * sp.damping_ratio * omega,
+                );
+            } else if let Some(m) = j.motor {
+                // A velocity drive (no stiffness, damping gain MOTOR_GAIN: near rigid) with
+                // the torque bound, as Box2D's motor.
+                joint = joint
+                    .motor_model(MotorModel::ForceBased)
+                    .motor_velocity(m.speed, MOTOR_GAIN)
+                    .motor_max_force(m.max_torque);
+            }
+            let mut joint = joint.build();
+            // Rapier's joint angle is that of frame 2 relative to frame 1: frame 1 turned by
+            // the reference angle makes it 0 there.
+            joint.data.local_frame1.rotation = Rotation::new(g.relative_angle);
+            world.impulse_joints.insert(bodies[g.a], bodies[g.b], joint, true);
+        }
+        Ok((bodies, hooks))
+    }
+
+    fn group_of(s: &ShapeSpec) -> i32 {
+        s.filter.map_or(0, |f| f.group)
     }
 
     impl RapierSim {
@@ -564,115 +784,7 @@ mod rapier_sim {
                 let _ = threads;
                 1
             };
-            let mut bodies = Vec::with_capacity(scene.bodies.len());
-            for b in &scene.bodies {
-                let mut builder = match b.kind {
-                    BodyKind::Static => RigidBodyBuilder::fixed(),
-                    BodyKind::Kinematic => RigidBodyBuilder::kinematic_velocity_based(),
-                    BodyKind::Dynamic => RigidBodyBuilder::dynamic(),
-                }
-                .translation(v(b.position))
-                .rotation(b.angle)
-                .can_sleep(scene.enable_sleep);
-                if b.kind != BodyKind::Static {
-                    builder = builder
-                        .linvel(v(b.linear_velocity))
-                        .angvel(b.angular_velocity)
-                        .linear_damping(b.linear_damping)
-                        .angular_damping(b.angular_damping)
-                        .gravity_scale(b.gravity_scale);
-                    if b.fixed_rotation {
-                        builder = builder.lock_rotations();
-                    }
-                }
-                let handle = world.bodies.insert(builder.build());
-                for s in &b.shapes {
-                    let m = scene.shape_material(s);
-                    let collider = match s.kind.as_str() {
-                        "circle" => ColliderBuilder::ball(shape_field(s.radius, "radius", s)?)
-                            .translation(v(s.center.unwrap_or([0.0, 0.0]))),
-                        "box" => {
-                            let h = shape_field(s.half_extents, "half_extents", s)?;
-                            ColliderBuilder::cuboid(h[0], h[1])
-                                .translation(v(s.center.unwrap_or([0.0, 0.0])))
-                                .rotation(s.angle.unwrap_or(0.0))
-                        }
-                        "polygon" => {
-                            let pts: Vec<Vector> = s
-                                .vertices
-                                .as_ref()
-                                .ok_or("a polygon needs \"vertices\"")?
-                                .iter()
-                                .map(|&p| v(p))
-                                .collect();
-                            let r = s.radius.unwrap_or(0.0);
-                            let c = if r > 0.0 {
-                                ColliderBuilder::round_convex_hull(&pts, r)
-                            } else {
-                                ColliderBuilder::convex_hull(&pts)
-                            };
-                            c.ok_or("rapier: convex hull failed")?
-                        }
-                        "capsule" => ColliderBuilder::capsule_from_endpoints(
-                            v(shape_field(s.center1, "center1", s)?),
-                            v(shape_field(s.center2, "center2", s)?),
-                            shape_field(s.radius, "radius", s)?,
-                        ),
-                        "segment" => ColliderBuilder::segment(
-                            v(shape_field(s.point1, "point1", s)?),
-                            v(shape_field(s.point2, "point2", s)?),
-                        ),
-                        other => return Err(format!("unknown shape type {other}").into()),
-                    }
-                    .collision_groups(groups(s)?)
-                    .density(m.density)
-                    .friction(m.friction_static)
-                    .friction_combine_rule(CoefficientCombineRule::GeometricMean)
-                    .restitution(m.restitution)
-                    .restitution_combine_rule(CoefficientCombineRule::Max);
-                    world.colliders.insert_with_parent(collider, handle, &mut world.bodies);
-                }
-                if b.kind == BodyKind::Dynamic && (b.force != [0.0, 0.0] || b.torque != 0.0) {
-                    // Rapier keeps user forces until reset_forces.
-                    let rb = &mut world.bodies[handle];
-                    rb.add_force(v(b.force), false);
-                    rb.add_torque(b.torque, false);
-                }
-                bodies.push(handle);
-            }
-            for j in &scene.joints {
-                let g = joint_geometry(scene, j)?;
-                if g.relative_angle != 0.0 && j.limit.is_some() {
-                    return Err(
-                        "rapier: a limited joint between bodies at different initial angles is not mapped".into(),
-                    );
-                }
-                if j.spring.is_some() {
-                    return Err(
-                        "rapier: joint springs are not mapped (Rapier's motor is either a spring or a velocity drive)"
-                            .into(),
-                    );
-                }
-                let mut joint = RevoluteJointBuilder::new()
-                    .local_anchor1(v(g.local_a))
-                    .local_anchor2(v(g.local_b))
-                    .contacts_enabled(j.collide_connected)
-                    .softness(SpringCoefficients::new(j.constraint_hertz, j.constraint_damping_ratio));
-                if let Some([lower, upper]) = j.limit {
-                    joint = joint.limits([lower, upper]);
-                }
-                if let Some(m) = j.motor {
-                    // A velocity drive (no stiffness, damping gain MOTOR_GAIN: near rigid) with
-                    // the torque bound, as Box2D's motor.
-                    joint = joint
-                        .motor_model(MotorModel::ForceBased)
-                        .motor_velocity(m.speed, MOTOR_GAIN)
-                        .motor_max_force(m.max_torque);
-                }
-                world
-                    .impulse_joints
-                    .insert(bodies[g.a], bodies[g.b], joint.build(), true);
-            }
+            let (bodies, hooks) = add_scene(&mut world, scene)?;
             // Bodies created asleep. Rapier wakes bodies whose contacts start touching, and
             // its sleep test compares each body's pose with the pose of its previous step
             // (a first step counts as motion), so a block of touching sleepers (smash)
@@ -703,14 +815,55 @@ mod rapier_sim {
                     a.time_since_can_sleep = a.time_until_sleep;
                 }
             }
-            Ok(RapierSim { world, bodies, threads })
+            Ok(RapierSim {
+                world,
+                bodies,
+                spawned: Default::default(),
+                hooks,
+                threads,
+            })
         }
     }
 
     impl Sim for RapierSim {
         fn step(&mut self) -> Result<(), BoxError> {
-            self.world.step();
+            if self.hooks {
+                self.world.step_with_events(&GroupHooks, &());
+            } else {
+                self.world.step();
+            }
             Ok(())
+        }
+        fn spawn(&mut self, tag: usize, batch: &SceneFile) -> Result<(), BoxError> {
+            let (handles, hooks) = add_scene(&mut self.world, batch)?;
+            self.hooks |= hooks;
+            self.spawned.entry(tag).or_default().extend(handles);
+            Ok(())
+        }
+        fn despawn(&mut self, tag: usize) -> Result<(), BoxError> {
+            let w = &mut self.world;
+            for h in self.spawned.remove(&tag).unwrap_or_default() {
+                w.bodies.remove(
+                    h,
+                    &mut w.islands,
+                    &mut w.colliders,
+                    &mut w.impulse_joints,
+                    &mut w.multibody_joints,
+                    &mut w.soft_bodies,
+                    true,
+                );
+            }
+            Ok(())
+        }
+        fn spawned_positions(&mut self, tag: usize) -> Vec<[f32; 2]> {
+            let handles = self.spawned.get(&tag).map(Vec::as_slice).unwrap_or_default();
+            handles
+                .iter()
+                .map(|&h| match self.world.bodies.get(h) {
+                    Some(rb) => [rb.translation().x, rb.translation().y],
+                    None => [f32::NAN; 2],
+                })
+                .collect()
         }
         fn set_kinematic_velocity(&mut self, i: usize, vel: [f32; 2], w: f32) -> Result<(), BoxError> {
             let rb = &mut self.world.bodies[self.bodies[i]];
@@ -749,6 +902,7 @@ mod rapier_sim {
         fn awake_count(&mut self) -> usize {
             self.bodies
                 .iter()
+                .chain(self.spawned.values().flatten())
                 .filter(|&&h| {
                     let rb = &self.world.bodies[h];
                     rb.is_dynamic() && !rb.is_sleeping()

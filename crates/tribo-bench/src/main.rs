@@ -29,7 +29,7 @@ use tribo_scenes::format::{BodyKind, SceneFile};
 )]
 struct Args {
     /// Scene to run: large_pyramid, many_pyramids, smash, tumbler, compounds, junkyard,
-    /// joint_grid, spinner, washer, or all (these nine); `scaling` runs the scaling scenes
+    /// joint_grid, spinner, rain, washer, or all (these ten); `scaling` runs the scaling scenes
     /// of `--sizes` instead; `scaling_rain_<n>` runs one.
     #[arg(default_value = "all", value_name = "SCENE")]
     scene_pos: String,
@@ -603,6 +603,18 @@ fn check(bench: &BenchScene, scene: &SceneFile, sim: &mut dyn Sim) -> Check {
                              "finite": finite}),
             }
         }
+        CheckKind::RagdollRain => {
+            let (bodies, below, off, lowest, finite) = scenes::rain_census(sim);
+            Check {
+                passed: finite && below == 0 && bodies > 0,
+                text: format!(
+                    "{below} of {bodies} ragdoll bodies below their shelf's top (lowest {lowest:.3} m above it), \
+                     {off} off a shelf's end"
+                ),
+                json: json!({"bodies": bodies, "below_shelf": below, "off_shelf": off,
+                             "lowest_above_shelf_m": lowest, "finite": finite}),
+            }
+        }
         CheckKind::Rain {
             half_width,
             max_outside,
@@ -692,9 +704,14 @@ fn kinematic_angle(scene: &SceneFile, sim: &mut dyn Sim, body: usize) -> (f32, f
 fn print_scene_table(bench: &BenchScene, scene: &SceneFile, results: &[EngineResult], args: &Args) {
     let dynamic = scene.bodies.iter().filter(|b| b.kind == BodyKind::Dynamic).count();
     println!(
-        "== {}: {} dynamic bodies, {} steps ({} timed), {} runs, sleep {}",
+        "== {}: {} dynamic bodies{}, {} steps ({} timed), {} runs, sleep {}",
         bench.name,
         dynamic,
+        if bench.hook.is_some() && dynamic == 0 {
+            " at the start (the step hook creates and destroys them)"
+        } else {
+            ""
+        },
         scene.steps,
         scene.steps - 1,
         results.first().map_or(0, |r| r.ms.len()),

@@ -1,7 +1,7 @@
 //! The benchmark scenes (engine-neutral [`SceneFile`]s) and scene transformations.
 //!
 //! `large_pyramid`, `many_pyramids`, `tumbler` (`tumbler_benchmark`), `compounds`,
-//! `junkyard`, `joint_grid`, `spinner` and `washer` come from `tribo_scenes::scenes`; `smash` is built here following shared/SCENES.md §2 (Box2D v3's
+//! `junkyard`, `joint_grid`, `spinner`, `washer` and `rain` (`ragdoll_rain`) come from `tribo_scenes::scenes`; `smash` is built here following shared/SCENES.md §2 (Box2D v3's
 //! `CreateSmash`). The scaling run's scenes are `tribo_scenes::scenes::scaling_rain(n)`.
 
 use crate::engines::BoxError;
@@ -46,6 +46,12 @@ pub enum CheckKind {
         /// Inner radius of the rim [m].
         radius: f32,
     },
+    /// Box2D's rain of ragdolls: no ragdoll body may end below the top of the shelf its
+    /// group was dropped onto (a body lying on a shelf has its origin at least the 3 cm
+    /// radius of its thinnest capsule above it, less the few millimetres a soft contact
+    /// lets it sink), unless it fell off a shelf's end (|x| beyond the shelf); every body
+    /// finite.
+    RagdollRain,
     /// Every body's centre must stay inside the container: |x| < `half_width` (the walls'
     /// inner faces) and y > 0 (the floor's top face), but for at most `max_outside` bodies,
     /// which must then be above `catch_y` (caught, not fallen through everything).
@@ -145,6 +151,12 @@ pub fn scenes() -> Vec<BenchScene> {
                     radius: tribo_scenes::scenes::SPINNER_RADIUS + 0.5,
                 },
             )
+        },
+        BenchScene {
+            note: "Rapier: group indices through a contact-filter hook; each joint's spring takes Rapier's one \
+                   motor (acceleration-based, ω² and 2ζω), the joint friction beside it is dropped",
+            hook: Some(rain_hook),
+            ..BenchScene::new("rain", tribo_scenes::scenes::ragdoll_rain, CheckKind::RagdollRain)
         },
         BenchScene {
             note: "Box2D's boxes report hit events; no engine reports them here",
@@ -287,4 +299,54 @@ fn junkyard_hook(n: u32, sim: &mut dyn Sim, scene: &SceneFile) -> Result<(), Box
     let x = sim.position(pusher)[0];
     let target = tribo_scenes::scenes::junkyard_pusher_x(n);
     sim.set_kinematic_velocity(pusher, [(target - x) / scene.dt, 0.0], 0.0)
+}
+
+/// The ragdoll columns of Box2D's rain, built once (the hook runs inside the timed loop;
+/// what it times is the engines' creation and destruction, as in Box2D's driver, not the
+/// making of the scene descriptions).
+fn rain_columns() -> &'static [SceneFile] {
+    static COLUMNS: std::sync::OnceLock<Vec<SceneFile>> = std::sync::OnceLock::new();
+    COLUMNS.get_or_init(|| {
+        (0..tribo_scenes::scenes::RAGDOLL_RAIN_COLUMNS)
+            .map(tribo_scenes::scenes::ragdoll_rain_column)
+            .collect()
+    })
+}
+
+/// Box2D's `StepRain`: before step `n` ([`tribo_scenes::scenes::ragdoll_rain_action`]),
+/// the next column of ragdolls is created, or the oldest destroyed and created again.
+fn rain_hook(n: u32, sim: &mut dyn Sim, _scene: &SceneFile) -> Result<(), BoxError> {
+    if let Some((column, exists)) = tribo_scenes::scenes::ragdoll_rain_action(n) {
+        if exists {
+            sim.despawn(column)?;
+        }
+        sim.spawn(column, &rain_columns()[column])?;
+    }
+    Ok(())
+}
+
+/// The rain's check ([`CheckKind::RagdollRain`]): (bodies, bodies below their shelf's top,
+/// bodies off a shelf's end, lowest height above its shelf's top [m], all finite).
+pub fn rain_census(sim: &mut dyn Sim) -> (usize, usize, usize, f32, bool) {
+    use tribo_scenes::scenes::{
+        ragdoll_rain_shelf_top, RAGDOLL_BODIES, RAGDOLL_RAIN_COLUMNS, RAGDOLL_RAIN_PER_GROUP,
+        RAGDOLL_RAIN_SHELF_HALF_LENGTH,
+    };
+    let (mut bodies, mut below, mut off, mut lowest, mut finite) = (0, 0, 0, f32::INFINITY, true);
+    for column in 0..RAGDOLL_RAIN_COLUMNS {
+        for (k, p) in sim.spawned_positions(column).into_iter().enumerate() {
+            bodies += 1;
+            let row = k / (RAGDOLL_RAIN_PER_GROUP * RAGDOLL_BODIES);
+            if !(p[0].is_finite() && p[1].is_finite()) {
+                finite = false;
+            } else if p[0].abs() > RAGDOLL_RAIN_SHELF_HALF_LENGTH {
+                off += 1;
+            } else {
+                let above = p[1] - ragdoll_rain_shelf_top(row);
+                lowest = lowest.min(above);
+                below += (above < 0.0) as usize;
+            }
+        }
+    }
+    (bodies, below, off, lowest, finite)
 }

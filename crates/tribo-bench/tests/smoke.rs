@@ -64,6 +64,7 @@ fn every_scene_runs_for_every_engine() {
         "junkyard",
         "joint_grid",
         "spinner",
+        "rain",
         "washer",
     ] {
         for engine in ["tribo", "box2d", "rapier"] {

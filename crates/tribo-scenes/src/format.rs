@@ -260,6 +260,10 @@ pub struct BodySpec {
     /// Whether the body starts awake. Default true.
     #[serde(default = "default_true", skip_serializing_if = "is_true")]
     pub awake: bool,
+    /// Speed [m/s] (|v| + |ω|·extent) below which the body may fall asleep. Default: the
+    /// engine's, 0.05 m/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sleep_threshold: Option<f32>,
     /// The body's shapes.
     #[serde(default)]
     pub shapes: Vec<ShapeSpec>,
@@ -411,6 +415,11 @@ pub struct JointSpec {
     /// Angular spring towards angle 0. Default: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spring: Option<SpringSpec>,
+    /// B's rotation relative to A [rad] at which the joint angle is 0 (the angle the limit,
+    /// the spring and the reported angle are measured from). Default: the bodies' relative
+    /// rotation in the file, so the joint angle starts at 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_angle: Option<f32>,
     /// Whether the two bodies' shapes still collide. Default false.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub collide_connected: bool,
@@ -452,6 +461,7 @@ impl JointSpec {
             limit: None,
             motor: None,
             spring: None,
+            reference_angle: None,
             collide_connected: false,
             constraint_hertz: tribo::DEFAULT_CONSTRAINT_HERTZ,
             constraint_damping_ratio: tribo::DEFAULT_CONSTRAINT_DAMPING_RATIO,
@@ -602,6 +612,9 @@ impl SceneFile {
             finite2(&format!("{p}.force"), b.force)?;
             finite(&format!("{p}.torque"), b.torque)?;
             finite(&format!("{p}.gravity_scale"), b.gravity_scale)?;
+            if let Some(t) = b.sleep_threshold {
+                non_negative(&format!("{p}.sleep_threshold"), t)?;
+            }
             for (field, v) in [
                 ("linear_damping", b.linear_damping),
                 ("angular_damping", b.angular_damping),
@@ -677,6 +690,9 @@ impl SceneFile {
                     format!("lower must be ≤ upper (got [{lower}, {upper}])"),
                 ));
             }
+        }
+        if let Some(r) = j.reference_angle {
+            finite(&format!("{p}.reference_angle"), r)?;
         }
         if let Some(m) = j.motor {
             finite(&format!("{p}.motor.speed"), m.speed)?;
@@ -793,6 +809,33 @@ impl SceneFile {
 
     /// Builds the world. The scene must have passed [`SceneFile::validate`] (parse does it).
     pub fn build(&self) -> Result<BuiltScene, SceneError> {
+        // `add_to` validates the scene before adding anything.
+        let mut world = World::new(WorldDef {
+            gravity: Vec2::new(self.gravity[0], self.gravity[1]),
+            substeps: self.substeps,
+            enable_sleep: self.enable_sleep,
+            ..WorldDef::default()
+        })
+        .map_err(|e| SceneError {
+            path: String::new(),
+            line: 0,
+            column: 0,
+            message: e.to_string(),
+        })?;
+        let bodies = self.add_to(&mut world)?;
+        Ok(BuiltScene {
+            world,
+            bodies,
+            dt: self.dt,
+            steps: self.steps,
+        })
+    }
+
+    /// Adds the scene's bodies and joints to an existing world (its world settings —
+    /// gravity, dt, substeps, sleep — are not used) and returns the new bodies in scene
+    /// order. Validates first: on an error nothing is added. A world-level error part way
+    /// (the world refusing a body) leaves what was added so far.
+    pub fn add_to(&self, world: &mut World) -> Result<Vec<BodyId>, SceneError> {
         self.validate().map_err(|(path, message)| SceneError {
             path,
             line: 0,
@@ -807,13 +850,6 @@ impl SceneFile {
                 message: e.to_string(),
             }
         };
-        let mut world = World::new(WorldDef {
-            gravity: Vec2::new(self.gravity[0], self.gravity[1]),
-            substeps: self.substeps,
-            enable_sleep: self.enable_sleep,
-            ..WorldDef::default()
-        })
-        .map_err(to_err(String::new()))?;
         let mut bodies = Vec::with_capacity(self.bodies.len());
         for (i, b) in self.bodies.iter().enumerate() {
             let p = format!("bodies[{i}]");
@@ -834,6 +870,7 @@ impl SceneFile {
                 constant_force: Vec2::new(b.force[0], b.force[1]),
                 constant_torque: b.torque,
                 awake: b.awake,
+                sleep_threshold: b.sleep_threshold.unwrap_or(BodyDef::default().sleep_threshold),
                 user_data: i as u64,
                 ..BodyDef::default()
             };
@@ -877,8 +914,11 @@ impl SceneFile {
             };
             let a = bodies[self.resolve_body(&p, &j.body_a).map_err(invalid)?];
             let b = bodies[self.resolve_body(&p, &j.body_b).map_err(invalid)?];
-            let mut def = RevoluteJointDef::at(&world, a, b, Vec2::new(j.anchor[0], j.anchor[1]))
+            let mut def = RevoluteJointDef::at(world, a, b, Vec2::new(j.anchor[0], j.anchor[1]))
                 .map_err(to_err(format!("{p}.anchor")))?;
+            if let Some(r) = j.reference_angle {
+                def.reference_angle = r;
+            }
             if let Some([lower, upper]) = j.limit {
                 def = def.limit(lower, upper);
             }
@@ -894,12 +934,7 @@ impl SceneFile {
             def.user_data = i as u64;
             world.create_revolute_joint(&def).map_err(to_err(p))?;
         }
-        Ok(BuiltScene {
-            world,
-            bodies,
-            dt: self.dt,
-            steps: self.steps,
-        })
+        Ok(bodies)
     }
 
     /// The scene as pretty JSON text.

@@ -3,7 +3,7 @@
 //! build for every engine.
 
 use crate::format::{
-    BodyKind, BodySpec, FilterSpec, JointSpec, MaterialRef, MaterialSpec, MotorSpec, SceneFile, ShapeSpec,
+    BodyKind, BodySpec, FilterSpec, JointSpec, MaterialRef, MaterialSpec, MotorSpec, SceneFile, ShapeSpec, SpringSpec,
 };
 use std::collections::BTreeMap;
 
@@ -1275,5 +1275,188 @@ mod sleep_tests {
         let built = SceneFile::build(&scene).expect("builds");
         let id = *built.bodies.last().expect("body");
         assert!(!built.world.body_is_awake(id).expect("live"));
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Box2D v3's rain benchmark (`CreateRain`, `StepRain`, the ragdoll of `shared/human.c`).
+
+/// Columns of ragdoll groups in Box2D's rain benchmark.
+pub const RAGDOLL_RAIN_COLUMNS: usize = 40;
+/// Rows of ragdoll groups (one static shelf per row).
+pub const RAGDOLL_RAIN_ROWS: usize = 5;
+/// Ragdolls per group.
+pub const RAGDOLL_RAIN_PER_GROUP: usize = 5;
+/// Bodies per ragdoll.
+pub const RAGDOLL_BODIES: usize = 11;
+/// The rain's hook acts every this many steps.
+pub const RAGDOLL_RAIN_INTERVAL: u32 = 8;
+/// Half extent [m] of the shelves' boxes.
+const RAGDOLL_SHELF_HALF: f32 = 0.25;
+/// Half the length [m] of a shelf: boxes centred at x = −125 … 125.
+pub const RAGDOLL_RAIN_SHELF_HALF_LENGTH: f32 = 125.0 + RAGDOLL_SHELF_HALF;
+
+/// Height [m] of shelf `row`'s box centres (y = 0, 45, 90, 135, 180).
+pub fn ragdoll_rain_shelf_y(row: usize) -> f32 {
+    45.0 * row as f32
+}
+
+/// Top face [m] of shelf `row`.
+pub fn ragdoll_rain_shelf_top(row: usize) -> f32 {
+    ragdoll_rain_shelf_y(row) + RAGDOLL_SHELF_HALF
+}
+
+/// Box2D v3's rain benchmark world (SCENES.md §2, `CreateRain`): one static body with 5
+/// shelves (y = 0, 45, …, 180 m) of 501 boxes half 0.25 m each at x = −125 … 125 step 0.5;
+/// gravity (0, −10) m/s², sleep on, 1 000 steps. The ragdolls arrive through the step hook:
+/// every [`RAGDOLL_RAIN_INTERVAL`] steps one column of [`ragdoll_rain_column`] is created,
+/// the oldest destroyed and created again once all 40 exist.
+pub fn ragdoll_rain() -> SceneFile {
+    let mut s = scene(
+        "Box2D v3 benchmark rain: ragdolls falling onto five shelves (the ragdolls come from the step hook)",
+        1000,
+    );
+    s.gravity = [0.0, -10.0];
+    let mut ground = body(Some("ground".into()), BodyKind::Static, [0.0, 0.0], 0.0, Vec::new());
+    for row in 0..RAGDOLL_RAIN_ROWS {
+        for i in 0..=500 {
+            let x = -125.0 + 0.5 * i as f32;
+            ground.shapes.push(offset_box(
+                RAGDOLL_SHELF_HALF,
+                RAGDOLL_SHELF_HALF,
+                [x, ragdoll_rain_shelf_y(row)],
+            ));
+        }
+    }
+    s.bodies.push(ground);
+    s
+}
+
+/// What the rain's hook does before step `n`: `None`, or the column to (re)create and
+/// whether it exists already (then it is destroyed first). Box2D's `StepRain`: every 8
+/// steps (from step 0), the next of the 40 columns while they are not all there, then the
+/// oldest in turn.
+pub fn ragdoll_rain_action(n: u32) -> Option<(usize, bool)> {
+    if n % RAGDOLL_RAIN_INTERVAL != 0 {
+        return None;
+    }
+    let k = (n / RAGDOLL_RAIN_INTERVAL) as usize;
+    Some((k % RAGDOLL_RAIN_COLUMNS, k >= RAGDOLL_RAIN_COLUMNS))
+}
+
+/// One column of Box2D's rain: for each of the 5 rows a group of 5 ragdolls, 0.5 m apart
+/// in x from the group point (−125 + 6.25 (column + ½), 40 + 45 row); ragdoll k of a group
+/// has filter group −(k+1), so ragdolls of one slot never collide (nor does a ragdoll with
+/// itself), those of different slots do. Bodies in order row, ragdoll, bone
+/// ([`ragdoll`]); 275 bodies, 250 joints; joints refer to bodies of this file.
+pub fn ragdoll_rain_column(column: usize) -> SceneFile {
+    let mut s = scene("one column of ragdolls of Box2D's rain benchmark", 1);
+    s.gravity = [0.0, -10.0];
+    let x0 = -125.0 + 6.25 * (column as f32 + 0.5);
+    for row in 0..RAGDOLL_RAIN_ROWS {
+        let y = 40.0 + 45.0 * row as f32;
+        for k in 0..RAGDOLL_RAIN_PER_GROUP {
+            ragdoll(&mut s, [x0 + 0.5 * k as f32, y], -(k as i32 + 1));
+        }
+    }
+    s
+}
+
+/// Box2D's ragdoll (`CreateHuman` at scale 1, friction torque 0.05 N·m, spring 5 Hz,
+/// ζ 0.5): 11 capsule bodies (the shins with a rounded foot polygon) on 10 revolute joints
+/// with limits, joint friction (a motor at speed 0 with max torque 0.05 N·m × the bone's
+/// friction scale) and a spring towards the standing pose, appended to `s` with its
+/// origin (between the feet) at `at`. Bodies: sleep threshold 0.1 m/s, density 1 kg/m²,
+/// friction 0.2 (feet 0.05), category 0x2, mask 0x1 | 0x2 (feet: 0x1, the ground only),
+/// the given filter group; head and forearms have linear damping 0.1 /s. Joint A is the
+/// parent bone, B the child; the forearm joints' angle is measured from B turned 0.25π
+/// relative to A (Box2D turns joint frame A).
+fn ragdoll(s: &mut SceneFile, at: [f32; 2], group: i32) {
+    use core::f32::consts::PI;
+    let material = |friction: f32| {
+        Some(MaterialRef::Inline(MaterialSpec {
+            density: Some(1.0),
+            friction: Some(friction),
+            ..MaterialSpec::default()
+        }))
+    };
+    let filter = |mask: u64| {
+        Some(FilterSpec {
+            category: 0x2,
+            mask,
+            group,
+        })
+    };
+    let capsule = |y1: f32, y2: f32, r: f32| ShapeSpec {
+        kind: "capsule".into(),
+        center1: Some([0.0, y1]),
+        center2: Some([0.0, y2]),
+        radius: Some(r),
+        material: material(0.2),
+        filter: filter(0x1 | 0x2),
+        ..ShapeSpec::default()
+    };
+    let foot = ShapeSpec {
+        kind: "polygon".into(),
+        vertices: Some(vec![[-0.03, -0.185], [0.11, -0.185], [0.11, -0.16], [-0.03, -0.14]]),
+        radius: Some(0.015),
+        material: material(0.05),
+        filter: filter(0x1),
+        ..ShapeSpec::default()
+    };
+    let first = s.bodies.len();
+    // (height of the body origin [m], shapes, linear damping [1/s]) per bone, in Box2D's
+    // bone order: hip, torso, head, upper/lower left leg, upper/lower right leg, upper/lower
+    // left arm, upper/lower right arm.
+    let leg_upper = || vec![capsule(-0.125, 0.125, 0.06)];
+    let leg_lower = || vec![capsule(-0.155, 0.125, 0.045), foot.clone()];
+    let arm_upper = || vec![capsule(-0.125, 0.125, 0.035)];
+    let arm_lower = || vec![capsule(-0.125, 0.125, 0.03)];
+    let bones: [(f32, Vec<ShapeSpec>, f32); RAGDOLL_BODIES] = [
+        (0.95, vec![capsule(-0.02, 0.02, 0.095)], 0.0),
+        (1.2, vec![capsule(-0.135, 0.135, 0.09)], 0.0),
+        (1.475, vec![capsule(-0.038, 0.039, 0.075)], 0.1),
+        (0.775, leg_upper(), 0.0),
+        (0.475, leg_lower(), 0.0),
+        (0.775, leg_upper(), 0.0),
+        (0.475, leg_lower(), 0.0),
+        (1.225, arm_upper(), 0.0),
+        (0.975, arm_lower(), 0.1),
+        (1.225, arm_upper(), 0.0),
+        (0.975, arm_lower(), 0.1),
+    ];
+    for (y, shapes, damping) in bones {
+        let mut b = body(None, BodyKind::Dynamic, [at[0], at[1] + y], 0.0, shapes);
+        b.linear_damping = damping;
+        b.sleep_threshold = Some(0.1);
+        s.bodies.push(b);
+    }
+    // (parent, child, pivot height [m], limits [×π rad], friction scale, reference angle).
+    let joints: [(usize, usize, f32, [f32; 2], f32, f32); RAGDOLL_BODIES - 1] = [
+        (0, 1, 1.0, [-0.25, 0.0], 0.5, 0.0),
+        (1, 2, 1.4, [-0.3, 0.1], 0.25, 0.0),
+        (0, 3, 0.9, [-0.05, 0.4], 1.0, 0.0),
+        (3, 4, 0.625, [-0.5, -0.02], 0.5, 0.0),
+        (0, 5, 0.9, [-0.05, 0.4], 1.0, 0.0),
+        (5, 6, 0.625, [-0.5, -0.02], 0.5, 0.0),
+        (1, 7, 1.35, [-0.1, 0.8], 0.5, 0.0),
+        (7, 8, 1.1, [-0.2, 0.3], 0.1, 0.25 * PI),
+        (1, 9, 1.35, [-0.1, 0.8], 0.5, 0.0),
+        (9, 10, 1.1, [-0.2, 0.3], 0.1, 0.25 * PI),
+    ];
+    for (parent, child, y, [lower, upper], friction_scale, reference) in joints {
+        s.joints.push(JointSpec {
+            limit: Some([lower * PI, upper * PI]),
+            motor: Some(MotorSpec {
+                speed: 0.0,
+                max_torque: 0.05 * friction_scale,
+            }),
+            spring: Some(SpringSpec {
+                hertz: 5.0,
+                damping_ratio: 0.5,
+            }),
+            reference_angle: (reference != 0.0).then_some(reference),
+            ..JointSpec::revolute(first + parent, first + child, [at[0], at[1] + y])
+        });
     }
 }

@@ -162,6 +162,7 @@ fn full_joint() -> JointSpec {
             hertz: 2.0,
             damping_ratio: 0.3,
         }),
+        reference_angle: Some(0.25),
         collide_connected: true,
         constraint_hertz: 30.0,
         constraint_damping_ratio: 1.0,
@@ -183,6 +184,7 @@ fn full_body() -> BodySpec {
         angular_damping: 0.2,
         fixed_rotation: true,
         awake: false,
+        sleep_threshold: Some(0.1),
         shapes: vec![full_shape()],
     }
 }
@@ -305,7 +307,17 @@ fn every_object_forbids_unknown_fields() {
 fn every_field_has_a_description_with_unit_and_a_default() {
     let root = schema();
     // Fields that are optional but have no fixed value to write as "default".
-    let no_default = ["description", "name", "material", "filter", "limit", "motor", "spring"];
+    let no_default = [
+        "description",
+        "name",
+        "material",
+        "filter",
+        "limit",
+        "motor",
+        "spring",
+        "reference_angle",
+        "sleep_threshold",
+    ];
     let mut objects: Vec<(String, &Value)> = vec![
         ("scene".into(), &root),
         ("material".into(), def(&root, "material")),
