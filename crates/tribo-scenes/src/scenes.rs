@@ -80,6 +80,11 @@ pub const SCENES: &[SceneEntry] = &[
         build: spinner,
     },
     SceneEntry {
+        name: "ragdolls",
+        about: "Box2D's ragdoll (its rain benchmark's): 10 of them dropped 5 m onto a shelf, on limited, sprung, frictional joints",
+        build: ragdolls,
+    },
+    SceneEntry {
         name: "scaling_rain_1k",
         about: "1 000 boxes and disks raining into a 50 m wide container (the smallest benchmark scaling scene)",
         build: scaling_rain_1k,
@@ -1329,6 +1334,33 @@ pub fn ragdoll_rain() -> SceneFile {
         }
     }
     s.bodies.push(ground);
+    s
+}
+
+/// Ten of the rain benchmark's ragdolls ([`ragdoll`]) in two groups of five (the five of a
+/// group collide with each other; the same slot of the two groups shares a filter group),
+/// dropped from 5 m onto a shelf of the rain's boxes 20.5 m long; gravity (0, −10) m/s²,
+/// 240 steps.
+pub fn ragdolls() -> SceneFile {
+    let mut s = scene(
+        "Box2D's ragdoll: 10 of them dropped 5 m onto a shelf of boxes (limited, sprung, frictional joints)",
+        240,
+    );
+    s.gravity = [0.0, -10.0];
+    let mut ground = body(Some("shelf".into()), BodyKind::Static, [0.0, 0.0], 0.0, Vec::new());
+    for i in -20..=20 {
+        ground.shapes.push(offset_box(
+            RAGDOLL_SHELF_HALF,
+            RAGDOLL_SHELF_HALF,
+            [0.5 * i as f32, 0.0],
+        ));
+    }
+    s.bodies.push(ground);
+    for x in [-3.0, 0.75] {
+        for k in 0..RAGDOLL_RAIN_PER_GROUP {
+            ragdoll(&mut s, [x + 0.5 * k as f32, 5.0], -(k as i32 + 1));
+        }
+    }
     s
 }
 
