@@ -190,6 +190,12 @@ const PREFETCH_STORED: usize = 8;
 /// Contacts per parallel chunk of the impulse store.
 const CONTACT_STORE_CHUNK: usize = 512;
 
+/// Colours open to constraints between two moving bodies, as bits (0 … DYNAMIC_COLORS − 1).
+const DYNAMIC_COLOR_BITS: u32 = (1 << DYNAMIC_COLORS) - 1;
+/// Colours open to constraints with a static or kinematic side, as bits (1 … COLORS − 1).
+const STATIC_COLOR_BITS: u32 = ((1 << COLORS) - 1) & !1;
+const _: () = assert!(COLORS <= 32);
+
 /// No colour: the constraint goes to the overflow list.
 const OVERFLOW: u8 = u8::MAX;
 
@@ -287,11 +293,14 @@ impl ContactSolver {
             );
             let busy = (if da { self.used[b.index_a as usize] } else { 0 })
                 | (if db { self.used[b.index_b as usize] } else { 0 });
-            let free = |k: &usize| busy & (1 << *k) == 0;
+            // The lowest free colour below DYNAMIC_COLORS, or the highest free one from 1 up
+            // (bit scans of the free colours).
             let colour = if da && db {
-                (0..DYNAMIC_COLORS).find(free)
+                let free = !busy & DYNAMIC_COLOR_BITS;
+                (free != 0).then(|| free.trailing_zeros() as usize)
             } else {
-                (1..COLORS).rev().find(free)
+                let free = !busy & STATIC_COLOR_BITS;
+                (free != 0).then(|| 31 - free.leading_zeros() as usize)
             };
             match colour {
                 Some(k) => {
