@@ -110,3 +110,16 @@ fn two_threads_also_time_one_thread_in_the_same_run() {
         }
     }
 }
+
+/// Rain through its first re-creation: by step 312 all 40 columns exist (11 000 ragdoll
+/// bodies), at step 320 the hook destroys column 0 and creates it again, so each engine
+/// must still hold exactly 40 × 275 bodies, none through a shelf.
+#[test]
+fn rain_hook_creates_and_destroys_ragdolls_in_every_engine() {
+    let (stdout, records) = run(&["rain", "--runs", "1", "--steps", "330", "--no-friction-table"]);
+    for engine in ["tribo", "box2d", "rapier"] {
+        let r = record(&records, &stdout, "rain", engine, &FIELDS);
+        assert_eq!(r["check"]["bodies"], 11_000, "{engine}: {}", r["check"]);
+        assert_eq!(r["check_passed"], true, "{engine}: {}", r["check"]);
+    }
+}
