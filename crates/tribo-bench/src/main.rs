@@ -333,7 +333,7 @@ fn run_scene(
             let build_s = t_build.elapsed().as_secs_f64();
             let awake_at_build = sim.awake_count();
             if let Some(hook) = bench.hook {
-                hook(0, sim.as_mut(), scene)?;
+                scenes::run_hook(hook, 0, sim.as_mut(), scene)?;
             }
             sim.step()?; // untimed first step (index 0)
             let awake_after_first = sim.awake_count();
@@ -341,7 +341,7 @@ fn run_scene(
             // The scene's hook runs inside the timed loop (Box2D's driver does the same).
             for n in 1..=timed {
                 if let Some(hook) = bench.hook {
-                    hook(n, sim.as_mut(), scene)?;
+                    scenes::run_hook(hook, n, sim.as_mut(), scene)?;
                 }
                 sim.step()?;
                 if args.profile {

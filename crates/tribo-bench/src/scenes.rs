@@ -65,9 +65,28 @@ pub enum CheckKind {
     },
 }
 
-/// A per-step hook: called before step `n` (0 = the untimed first step) with the engine
-/// and the scene, inside the timing loop as Box2D's benchmark driver does.
-pub type Hook = fn(n: u32, sim: &mut dyn Sim, scene: &SceneFile) -> Result<(), BoxError>;
+/// A per-step hook ([`tribo_scenes::scenes::StepHook`]): called before step `n` (0 = the
+/// untimed first step), inside the timing loop as Box2D's benchmark driver does; its
+/// actions are applied to the engine by [`run_hook`].
+pub type Hook = tribo_scenes::scenes::StepHook;
+
+/// Runs a scene's hook before step `n` and applies what it asks to `sim`.
+pub fn run_hook(hook: Hook, n: u32, sim: &mut dyn Sim, scene: &SceneFile) -> Result<(), BoxError> {
+    use tribo_scenes::scenes::HookAction;
+    let actions = hook(n, scene.dt, &mut |i| sim.position(i));
+    for action in actions {
+        match action {
+            HookAction::SetVelocity {
+                body,
+                velocity,
+                angular_velocity,
+            } => sim.set_kinematic_velocity(body, velocity, angular_velocity)?,
+            HookAction::Despawn { tag } => sim.despawn(tag)?,
+            HookAction::Spawn { tag, batch } => sim.spawn(tag, batch)?,
+        }
+    }
+    Ok(())
+}
 
 /// A benchmark scene.
 pub struct BenchScene {
@@ -124,7 +143,7 @@ pub fn scenes() -> Vec<BenchScene> {
             )
         },
         BenchScene {
-            hook: Some(junkyard_hook),
+            hook: Some(tribo_scenes::scenes::junkyard_hook),
             ..BenchScene::new(
                 "junkyard",
                 tribo_scenes::scenes::junkyard,
@@ -155,7 +174,7 @@ pub fn scenes() -> Vec<BenchScene> {
         BenchScene {
             note: "Rapier: group indices through a contact-filter hook; each joint's spring takes Rapier's one \
                    motor (acceleration-based, ω² and 2ζω), the joint friction beside it is dropped",
-            hook: Some(rain_hook),
+            hook: Some(tribo_scenes::scenes::ragdoll_rain_hook),
             ..BenchScene::new("rain", tribo_scenes::scenes::ragdoll_rain, CheckKind::RagdollRain)
         },
         BenchScene {
@@ -289,40 +308,6 @@ mod tests {
         let m = s.shape_material(&s.bodies[1].shapes[0]);
         assert!((m.friction_static - 0.9).abs() < 1e-6 && (m.friction_dynamic - 0.6).abs() < 1e-6);
     }
-}
-
-/// Junkyard's pusher (the last body): before step `n` its velocity is set so that it
-/// reaches [`tribo_scenes::scenes::junkyard_pusher_x`] at the end of the step, as Box2D's
-/// `b2Body_SetTargetTransform` does (y stays 0, no rotation).
-fn junkyard_hook(n: u32, sim: &mut dyn Sim, scene: &SceneFile) -> Result<(), BoxError> {
-    let pusher = scene.bodies.len().saturating_sub(1);
-    let x = sim.position(pusher)[0];
-    let target = tribo_scenes::scenes::junkyard_pusher_x(n);
-    sim.set_kinematic_velocity(pusher, [(target - x) / scene.dt, 0.0], 0.0)
-}
-
-/// The ragdoll columns of Box2D's rain, built once (the hook runs inside the timed loop;
-/// what it times is the engines' creation and destruction, as in Box2D's driver, not the
-/// making of the scene descriptions).
-fn rain_columns() -> &'static [SceneFile] {
-    static COLUMNS: std::sync::OnceLock<Vec<SceneFile>> = std::sync::OnceLock::new();
-    COLUMNS.get_or_init(|| {
-        (0..tribo_scenes::scenes::RAGDOLL_RAIN_COLUMNS)
-            .map(tribo_scenes::scenes::ragdoll_rain_column)
-            .collect()
-    })
-}
-
-/// Box2D's `StepRain`: before step `n` ([`tribo_scenes::scenes::ragdoll_rain_action`]),
-/// the next column of ragdolls is created, or the oldest destroyed and created again.
-fn rain_hook(n: u32, sim: &mut dyn Sim, _scene: &SceneFile) -> Result<(), BoxError> {
-    if let Some((column, exists)) = tribo_scenes::scenes::ragdoll_rain_action(n) {
-        if exists {
-            sim.despawn(column)?;
-        }
-        sim.spawn(column, &rain_columns()[column])?;
-    }
-    Ok(())
 }
 
 /// The rain's check ([`CheckKind::RagdollRain`]): (bodies, bodies below their shelf's top,

@@ -98,15 +98,17 @@ fn main() -> ExitCode {
     }
 }
 
-/// Loads a scene file or a built-in scene.
-fn load_scene(name: &str) -> Result<SceneFile, String> {
+/// Loads a scene file or a built-in scene (with its step hook, if it has one).
+fn load_scene(name: &str) -> Result<(SceneFile, Option<scenes::StepHook>), String> {
     let path = Path::new(name);
     if path.extension().is_some_and(|e| e == "json") || path.exists() {
         let text = std::fs::read_to_string(path).map_err(|e| format!("{name}: cannot read: {e}"))?;
-        return format::parse(&text).map_err(|e| format!("{name}: {e}"));
+        return format::parse(&text)
+            .map(|s| (s, None))
+            .map_err(|e| format!("{name}: {e}"));
     }
     match scenes::find(name) {
-        Some(entry) => Ok((entry.build)()),
+        Some(entry) => Ok(((entry.build)(), entry.hook)),
         None => {
             let names: Vec<&str> = scenes::SCENES.iter().map(|s| s.name).collect();
             Err(format!(
@@ -132,7 +134,7 @@ fn export(name: &str, file: &Path) -> Result<(), String> {
 }
 
 fn run(args: &RunArgs) -> Result<(), String> {
-    let mut scene = load_scene(&args.scene)?;
+    let (mut scene, hook) = load_scene(&args.scene)?;
     if let Some(steps) = args.steps {
         scene.steps = steps;
     }
@@ -175,7 +177,7 @@ fn run(args: &RunArgs) -> Result<(), String> {
         ..*built.world.def()
     };
     built.world.set_def(def).map_err(|e| format!("--threads: {e}"))?;
-    let mut sim = output::Simulation::new(&scene, built);
+    let mut sim = output::Simulation::new(&scene, built, hook);
     let mut writers = output::Writers::new(traj_kind, args.out.as_deref(), args.contacts.as_deref());
     let mut frames = output::FrameRecorder::new(picture_kind, scene.steps, scene.dt);
     writers.record(&sim, 0).map_err(|e| e.to_string())?;

@@ -5,13 +5,14 @@
 use crate::frame::{DrawContact, DrawKind, DrawShape, Frame};
 use crate::render;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use tribo::{BodyType, FrictionState, Shape};
 use tribo_scenes::format::{BuiltScene, MaterialRef, SceneFile};
+use tribo_scenes::scenes::{HookAction, StepHook};
 
 /// Writes `bytes` to `path` through a temporary file in the same folder.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
@@ -69,14 +70,24 @@ impl PictureFormat {
     }
 }
 
-/// A running scene: the world, body names and material colours.
+/// A running scene: the world, body names and material colours, and the bodies its step
+/// hook created.
 pub struct Simulation {
     /// The built world.
     pub built: BuiltScene,
     names: Vec<String>,
     /// Fill colour of each (body, shape) by the shape's material.
     colors: Vec<Vec<[u8; 3]>>,
+    /// Palette index of each material seen (in order of first use).
+    keys: HashMap<String, usize>,
+    /// The scene's step hook, if any.
+    hook: Option<StepHook>,
+    /// Bodies the hook created, by tag: id and shape colours.
+    spawned: BTreeMap<usize, Vec<(tribo::BodyId, Vec<[u8; 3]>)>>,
+    /// Name of each body the hook created ("TAG.K": the K-th body of batch TAG).
+    spawned_names: HashMap<tribo::BodyId, String>,
     time: f64,
+    steps_done: u32,
 }
 
 /// Colours for materials in order of first use.
@@ -91,38 +102,102 @@ const PALETTE: [[u8; 3]; 8] = [
     [196, 160, 140], // tan
 ];
 
+/// Fill colours of a scene's shapes by material, palette indices shared through `keys`.
+fn shape_colors(scene: &SceneFile, keys: &mut HashMap<String, usize>) -> Vec<Vec<[u8; 3]>> {
+    scene
+        .bodies
+        .iter()
+        .map(|b| {
+            b.shapes
+                .iter()
+                .map(|s| {
+                    let key = match &s.material {
+                        None => "default".to_string(),
+                        Some(MaterialRef::Named(n)) => n.clone(),
+                        Some(MaterialRef::Inline(m)) => format!("{m:?}"),
+                    };
+                    let n = keys.len();
+                    let idx = *keys.entry(key).or_insert(n);
+                    PALETTE[idx % PALETTE.len()]
+                })
+                .collect()
+        })
+        .collect()
+}
+
 impl Simulation {
-    /// Wraps a built scene.
-    pub fn new(scene: &SceneFile, built: BuiltScene) -> Simulation {
-        let mut keys: HashMap<String, usize> = HashMap::new();
-        let mut colors = Vec::with_capacity(scene.bodies.len());
-        for b in &scene.bodies {
-            let mut row = Vec::with_capacity(b.shapes.len());
-            for s in &b.shapes {
-                let key = match &s.material {
-                    None => "default".to_string(),
-                    Some(MaterialRef::Named(n)) => n.clone(),
-                    Some(MaterialRef::Inline(m)) => format!("{m:?}"),
-                };
-                let n = keys.len();
-                let idx = *keys.entry(key).or_insert(n);
-                row.push(PALETTE[idx % PALETTE.len()]);
-            }
-            colors.push(row);
-        }
+    /// Wraps a built scene (and its step hook, run before every step).
+    pub fn new(scene: &SceneFile, built: BuiltScene, hook: Option<StepHook>) -> Simulation {
+        let mut keys = HashMap::new();
+        let colors = shape_colors(scene, &mut keys);
         let names = (0..scene.bodies.len()).map(|i| scene.body_name(i)).collect();
         Simulation {
             built,
             names,
             colors,
+            keys,
+            hook,
+            spawned: BTreeMap::new(),
+            spawned_names: HashMap::new(),
             time: 0.0,
+            steps_done: 0,
         }
     }
 
-    /// Advances one step.
-    pub fn step(&mut self) -> tribo::Result<()> {
-        self.built.world.step(self.built.dt)?;
+    /// Runs the hook (if any), then advances one step.
+    pub fn step(&mut self) -> Result<(), String> {
+        if let Some(hook) = self.hook {
+            let (world, bodies) = (&self.built.world, &self.built.bodies);
+            let mut position = |i: usize| {
+                bodies
+                    .get(i)
+                    .and_then(|&id| world.body_position(id).ok())
+                    .map_or([f32::NAN; 2], |p| [p.x, p.y])
+            };
+            for action in hook(self.steps_done, self.built.dt, &mut position) {
+                self.apply(action).map_err(|e| format!("the scene's step hook: {e}"))?;
+            }
+        }
+        self.built.world.step(self.built.dt).map_err(|e| e.to_string())?;
         self.time += f64::from(self.built.dt);
+        self.steps_done += 1;
+        Ok(())
+    }
+
+    /// Does one thing the hook asked.
+    fn apply(&mut self, action: HookAction) -> Result<(), String> {
+        let world = &mut self.built.world;
+        match action {
+            HookAction::SetVelocity {
+                body,
+                velocity,
+                angular_velocity,
+            } => {
+                if let Some(&id) = self.built.bodies.get(body) {
+                    world
+                        .set_body_linear_velocity(id, tribo::Vec2::new(velocity[0], velocity[1]))
+                        .map_err(|e| e.to_string())?;
+                    world
+                        .set_body_angular_velocity(id, angular_velocity)
+                        .map_err(|e| e.to_string())?;
+                }
+            }
+            HookAction::Despawn { tag } => {
+                for (id, _) in self.spawned.remove(&tag).unwrap_or_default() {
+                    self.spawned_names.remove(&id);
+                    world.destroy_body(id).map_err(|e| e.to_string())?;
+                }
+            }
+            HookAction::Spawn { tag, batch } => {
+                let ids = batch.add_to(world).map_err(|e| e.to_string())?;
+                let colors = shape_colors(batch, &mut self.keys);
+                let list = self.spawned.entry(tag).or_default();
+                for (id, row) in ids.into_iter().zip(colors) {
+                    self.spawned_names.insert(id, format!("{tag}.{}", list.len()));
+                    list.push((id, row));
+                }
+            }
+        }
         Ok(())
     }
 
@@ -139,8 +214,15 @@ impl Simulation {
             ..Frame::default()
         };
         // Static bodies first so moving ones are drawn over the ground.
+        let scene_bodies = self
+            .built
+            .bodies
+            .iter()
+            .zip(self.colors.iter().map(Some).chain(std::iter::repeat(None)));
+        let spawned = self.spawned.values().flatten().map(|(id, row)| (id, Some(row)));
+        let bodies: Vec<(&tribo::BodyId, Option<&Vec<[u8; 3]>>)> = scene_bodies.chain(spawned).collect();
         for pass_static in [true, false] {
-            for (i, &id) in self.built.bodies.iter().enumerate() {
+            for &(&id, colors) in &bodies {
                 let (Ok(xf), Ok(kind), Ok(shapes)) =
                     (world.body_transform(id), world.body_type(id), world.body_shapes(id))
                 else {
@@ -179,12 +261,7 @@ impl Simulation {
                             p2: p(s.point2),
                         },
                     };
-                    let fill = self
-                        .colors
-                        .get(i)
-                        .and_then(|row| row.get(j))
-                        .copied()
-                        .unwrap_or(PALETTE[0]);
+                    let fill = colors.and_then(|row| row.get(j)).copied().unwrap_or(PALETTE[0]);
                     frame.shapes.push(DrawShape {
                         kind,
                         fill,
@@ -212,6 +289,9 @@ impl Simulation {
     }
 
     fn name_of(&self, id: tribo::BodyId) -> String {
+        if let Some(name) = self.spawned_names.get(&id) {
+            return name.clone();
+        }
         self.built
             .world
             .body_user_data(id)
@@ -501,7 +581,7 @@ pub fn report_pictures() -> Vec<crate::report::Picture> {
         };
         let scene = (entry.build)();
         let Ok(built) = scene.build() else { continue };
-        let mut sim = Simulation::new(&scene, built);
+        let mut sim = Simulation::new(&scene, built, None);
         let mut frames = vec![sim.frame()];
         let steps = scene.steps.min(180);
         for _ in 0..steps {

@@ -46,6 +46,10 @@ const HATCH_SPACING: f32 = 7.0;
 const CONTACT_RADIUS: f32 = 3.5;
 /// Radius of a joint pivot's ring [px].
 const JOINT_RADIUS: f32 = 3.0;
+/// Pixels per metre from which contact and joint markers have their full size.
+const MARKER_FULL_SCALE: f32 = 20.0;
+/// Smallest marker size factor (pictures of large scenes).
+const MARKER_MIN: f32 = 0.35;
 /// Length of the contact normal tick [px].
 const CONTACT_TICK: f32 = 14.0;
 /// Distance of the overlay panels from the image border [px].
@@ -810,12 +814,7 @@ impl<'a> Scene<'a> {
             return;
         }
         let color = rgb(if c.stick { STICK_COLOR } else { SLIP_COLOR });
-        // Markers shrink a little on small pictures (where the text does too).
-        let k = if text_scale(self.cam.width, self.cam.height) >= 2 {
-            1.0
-        } else {
-            0.7
-        };
+        let k = self.marker_scale();
         let (radius, tick) = (CONTACT_RADIUS * k, CONTACT_TICK * k);
         let nl = c.normal[0].hypot(c.normal[1]);
         if nl.is_finite() && nl > 1e-6 {
@@ -851,6 +850,19 @@ impl<'a> Scene<'a> {
     }
 
     /// A joint pivot: a small white ring with a dark outline.
+    /// Size factor of the contact and joint markers: smaller on small pictures (where the
+    /// text shrinks too), and in pictures of large scenes, below
+    /// [`MARKER_FULL_SCALE`] pixels per metre (down to [`MARKER_MIN`]), so markers of
+    /// fixed pixel size do not bury the shapes (Box2D's rain: 250 m across, 3 px/m).
+    fn marker_scale(&self) -> f32 {
+        let text = if text_scale(self.cam.width, self.cam.height) >= 2 {
+            1.0
+        } else {
+            0.7
+        };
+        text * (self.cam.scale / MARKER_FULL_SCALE).clamp(MARKER_MIN, 1.0)
+    }
+
     fn joint(&mut self, at: [f32; 2]) {
         if !finite2(at) {
             return;
@@ -859,11 +871,7 @@ impl<'a> Scene<'a> {
         if p[0] < self.clip_min[0] || p[0] > self.clip_max[0] || p[1] < self.clip_min[1] || p[1] > self.clip_max[1] {
             return;
         }
-        let k = if text_scale(self.cam.width, self.cam.height) >= 2 {
-            1.0
-        } else {
-            0.7
-        };
+        let k = self.marker_scale();
         self.prims.push(Prim::Circle {
             c: p,
             r: JOINT_RADIUS * k,

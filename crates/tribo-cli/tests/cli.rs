@@ -39,6 +39,8 @@ fn scenes_lists_every_builtin() {
         "tumbler",
         "large_pyramid",
         "many_pyramids",
+        "rain",
+        "ragdolls",
     ] {
         assert!(
             text.lines().any(|l| l.starts_with(name)),
@@ -408,4 +410,32 @@ fn validate_prints_the_table_and_writes_a_self_contained_report() {
         !html.contains("http://") && !html.contains("https://"),
         "report must not need the network"
     );
+}
+
+/// Built-in scenes run their step hooks in the CLI as in the benchmark: junkyard's
+/// kinematic pusher is driven to 60 sin(0.2 n / 60) m (its velocity set before step n so
+/// it arrives at the end of it, as Box2D's `b2Body_SetTargetTransform`): after 60 steps it
+/// is at 60 sin(0.2 · 59/60) = 11.69 m (1 mm: one step's f32 integration), where the scene
+/// file alone leaves it at 0; and rain's hook creates a column of 275 ragdoll bodies every
+/// 8 steps (3 columns by step 17, so 1 + 825 bodies) and draws them.
+#[test]
+fn built_in_scenes_run_their_step_hooks() {
+    let dir = tmp_dir("hooks");
+    let csv = dir.join("junk.csv");
+    let out = tribo(&["run", "junkyard", "--steps", "60", "--every", "60", "--out", s(&csv)]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let rows = read_csv(&csv);
+    let pusher = rows.iter().find(|r| r.0 == 60 && r.1 == "pusher").expect("pusher row");
+    let expected = 60.0 * (0.2f64 * 59.0 / 60.0).sin();
+    assert!(
+        (pusher.2 - expected).abs() < 1e-3,
+        "pusher at {} m, expected {expected}",
+        pusher.2
+    );
+    let png = dir.join("rain.png");
+    let out = tribo(&["run", "rain", "--steps", "17", "--render", s(&png)]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("826 bodies"), "{stderr}");
+    assert!(png.exists());
 }

@@ -15,6 +15,8 @@ pub struct SceneEntry {
     pub about: &'static str,
     /// Builds the scene.
     pub build: fn() -> SceneFile,
+    /// What the scene does before each step, if anything (Box2D's `Step…` functions).
+    pub hook: Option<StepHook>,
 }
 
 /// Every built-in scene, in the order `tribo scenes` lists them.
@@ -23,98 +25,195 @@ pub const SCENES: &[SceneEntry] = &[
         name: "incline",
         about: "μd < tan θ < μs: a block released at rest sticks, a pushed one keeps sliding, a one-μ block slides",
         build: incline,
+        hook: None,
     },
     SceneEntry {
         name: "friction_ramp",
         about: "Box2D's friction sample: five boxes of μ 0.75…0 on ramps of 0.25 rad; the first three hold",
         build: friction_ramp,
+        hook: None,
     },
     SceneEntry {
         name: "pyramid",
         about: "a 20-row pyramid of unit boxes standing still",
         build: pyramid,
+        hook: None,
     },
     SceneEntry {
         name: "card_house",
         about: "a two-storey house of leaning cards that stands only through static friction",
         build: card_house,
+        hook: None,
     },
     SceneEntry {
         name: "dominoes",
         about: "a row of 24 dominoes toppled by a push on the first",
         build: dominoes,
+        hook: None,
     },
     SceneEntry {
         name: "rolling",
         about: "disks launched sliding without spin start to roll at 2/3 of their speed",
         build: rolling,
+        hook: None,
     },
     SceneEntry {
         name: "bounce",
         about: "a row of balls with restitution 0 to 1 dropped from 3 m",
         build: bounce,
+        hook: None,
     },
     SceneEntry {
         name: "conveyor",
         about: "boxes dropped on a belt moving at 2 m/s are carried along",
         build: conveyor,
+        hook: None,
     },
     SceneEntry {
         name: "tumbler",
         about: "a kinematic rotating box full of boxes and disks",
         build: tumbler,
+        hook: None,
     },
     SceneEntry {
         name: "tumbler_benchmark",
         about: "Box2D v3 benchmark tumbler: 2 025 small boxes in a 20 m drum driven at 25°/s by a revolute motor, 750 steps",
         build: tumbler_benchmark,
+        hook: None,
     },
     SceneEntry {
         name: "joint_grid",
         about: "Box2D v3 benchmark: a 100 × 100 grid of circles hanging on 19 800 revolute joints, 500 steps",
         build: joint_grid,
+        hook: None,
     },
     SceneEntry {
         name: "spinner",
         about: "Box2D v3 benchmark: a rotor on a revolute motor stirring 6 076 bodies in a 40 m ring, 500 steps",
         build: spinner,
+        hook: None,
     },
     SceneEntry {
         name: "ragdolls",
         about: "Box2D's ragdoll (its rain benchmark's): 10 of them dropped 5 m onto a shelf, on limited, sprung, frictional joints",
         build: ragdolls,
+        hook: None,
+    },
+    SceneEntry {
+        name: "rain",
+        about: "Box2D v3 benchmark rain: 1 000 ragdolls arrive in columns every 8 steps and fall onto five shelves, 1 000 steps",
+        build: ragdoll_rain,
+        hook: Some(ragdoll_rain_hook),
     },
     SceneEntry {
         name: "scaling_rain_1k",
         about: "1 000 boxes and disks raining into a 50 m wide container (the smallest benchmark scaling scene)",
         build: scaling_rain_1k,
+        hook: None,
     },
     SceneEntry {
         name: "large_pyramid",
         about: "Box2D v3 benchmark: a 100-row pyramid of 5 050 boxes, sleep off, 500 steps",
         build: large_pyramid,
+        hook: None,
     },
     SceneEntry {
         name: "compounds",
         about: "Box2D v3 benchmark: 3 000 bodies of two triangles fall into a container of boxes, 500 steps",
         build: compounds,
+        hook: None,
     },
     SceneEntry {
         name: "washer",
         about: "Box2D v3 benchmark: 8 100 small boxes tumbled by a kinematic ring turning at 25°/s, 500 steps",
         build: washer,
+        hook: None,
     },
     SceneEntry {
         name: "junkyard",
-        about: "Box2D v3 benchmark: 8 000 pentagons in a container (the pusher stands still here; the benchmark moves it), 800 steps",
+        about: "Box2D v3 benchmark: 8 000 pentagons in a container stirred by a kinematic pusher swinging ±60 m, 800 steps",
         build: junkyard,
+        hook: Some(junkyard_hook),
     },
     SceneEntry {
         name: "many_pyramids",
         about: "Box2D v3 benchmark: 20 × 20 pyramids of 55 boxes (22 000 boxes), sleep off, 200 steps",
         build: many_pyramids,
+        hook: None,
     },
 ];
+
+/// One thing a scene's step hook does before a step: the benchmark does it to every
+/// engine, the CLI to its Tribo world.
+#[derive(Clone, Copy, Debug)]
+pub enum HookAction {
+    /// Set the velocity [m/s] of the centre of mass and the angular velocity [rad/s] of
+    /// scene body `body` (an index into the scene's bodies).
+    SetVelocity {
+        /// Scene body index.
+        body: usize,
+        /// Linear velocity [m/s].
+        velocity: [f32; 2],
+        /// Angular velocity [rad/s].
+        angular_velocity: f32,
+    },
+    /// Destroy the bodies (with their shapes and joints) created under `tag`.
+    Despawn {
+        /// The batch's tag.
+        tag: usize,
+    },
+    /// Add the bodies and joints of `batch` (its joints refer to its own bodies; its world
+    /// settings are not used) under `tag`.
+    Spawn {
+        /// The batch's tag.
+        tag: usize,
+        /// What to add.
+        batch: &'static SceneFile,
+    },
+}
+
+/// A scene's step hook: given the index `n` of the step about to run (0 = the first), the
+/// step length `dt` [s] and a way to read a scene body's origin [m], what to do before
+/// the step, in order.
+pub type StepHook = fn(n: u32, dt: f32, position: &mut dyn FnMut(usize) -> [f32; 2]) -> Vec<HookAction>;
+
+/// Junkyard's pusher (the last body): before step `n` its velocity is set so that it
+/// reaches [`junkyard_pusher_x`] at the end of the step, as Box2D's
+/// `b2Body_SetTargetTransform` does (y stays 0, no rotation).
+pub fn junkyard_hook(n: u32, dt: f32, position: &mut dyn FnMut(usize) -> [f32; 2]) -> Vec<HookAction> {
+    let pusher = JUNKYARD_PUSHER;
+    let x = position(pusher)[0];
+    vec![HookAction::SetVelocity {
+        body: pusher,
+        velocity: [(junkyard_pusher_x(n) - x) / dt, 0.0],
+        angular_velocity: 0.0,
+    }]
+}
+
+/// The ragdoll columns of the rain, built once (hooks run inside the benchmark's timed
+/// loop: what it times is the engines' creation and destruction, as in Box2D's driver,
+/// not the making of the descriptions).
+pub fn ragdoll_rain_columns() -> &'static [SceneFile] {
+    static COLUMNS: std::sync::OnceLock<Vec<SceneFile>> = std::sync::OnceLock::new();
+    COLUMNS.get_or_init(|| (0..RAGDOLL_RAIN_COLUMNS).map(ragdoll_rain_column).collect())
+}
+
+/// Box2D's `StepRain` ([`ragdoll_rain_action`]): before step `n`, the next column of
+/// ragdolls (tag: its column) is created, or the oldest destroyed and created again.
+pub fn ragdoll_rain_hook(n: u32, _dt: f32, _position: &mut dyn FnMut(usize) -> [f32; 2]) -> Vec<HookAction> {
+    let Some((column, exists)) = ragdoll_rain_action(n) else {
+        return Vec::new();
+    };
+    let batch = &ragdoll_rain_columns()[column];
+    if exists {
+        vec![
+            HookAction::Despawn { tag: column },
+            HookAction::Spawn { tag: column, batch },
+        ]
+    } else {
+        vec![HookAction::Spawn { tag: column, batch }]
+    }
+}
 
 /// The built-in scene of that name.
 pub fn find(name: &str) -> Option<&'static SceneEntry> {
@@ -962,10 +1061,15 @@ pub fn junkyard_pusher_x(n: u32) -> f32 {
     60.0 * (0.2 * n as f32 / 60.0).sin()
 }
 
+/// Index of junkyard's pusher among its bodies (the last: after the ground and the 8 000
+/// pentagons).
+pub const JUNKYARD_PUSHER: usize = 8001;
+
 /// Box2D v3's junkyard benchmark scene (`CreateJunkyard`, shared/SCENES.md §2): 8 000
 /// pentagons in a container of static boxes, stirred by a kinematic pusher (the last
-/// body) that a per-step hook drives to [`junkyard_pusher_x`]. The scene file alone has
-/// the pusher at rest; the benchmark sets its velocity before every step.
+/// body, [`JUNKYARD_PUSHER`]) that the step hook [`junkyard_hook`] drives to
+/// [`junkyard_pusher_x`]. The scene file alone has the pusher at rest; the benchmark and
+/// the CLI run the hook before every step.
 pub fn junkyard() -> SceneFile {
     let mut s = scene(
         "Box2D v3 benchmark junkyard: 8 000 pentagons stirred by a kinematic pusher",
@@ -1193,6 +1297,7 @@ mod benchmark_scene_tests {
             assert!((p[0] - 0.25 * a.cos()).abs() < 1e-6 && (p[1] - 0.25 * a.sin()).abs() < 1e-6);
         }
         let pusher = s.bodies.last().expect("pusher");
+        assert_eq!(s.bodies.len() - 1, JUNKYARD_PUSHER);
         assert_eq!((pusher.kind, pusher.position), (BodyKind::Kinematic, [0.0, 0.0]));
         assert_eq!(pusher.shapes[0].half_extents, Some([2.0, 4.0]));
         assert_eq!(pusher.shapes[0].center, Some([0.0, 4.0]));
