@@ -130,6 +130,13 @@ fn export(name: &str, file: &Path) -> Result<(), String> {
     let text = (entry.build)().to_json();
     output::write_atomic(file, text.as_bytes()).map_err(|e| format!("{}: {e}", file.display()))?;
     eprintln!("wrote {} ({} bytes)", file.display(), text.len());
+    if entry.hook.is_some() {
+        eprintln!(
+            "note: {name} also has a step hook (bodies it moves, creates or destroys before each step), which a \
+             scene file cannot hold: `tribo run {name}` runs it, `tribo run {}` does not",
+            file.display()
+        );
+    }
     Ok(())
 }
 
