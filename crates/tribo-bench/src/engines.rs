@@ -663,6 +663,7 @@ mod rapier_sim {
             let handle = world.bodies.insert(builder.build());
             for s in &b.shapes {
                 let m = scene.shape_material(s);
+                let group = group_of(s);
                 let collider = match s.kind.as_str() {
                     "circle" => ColliderBuilder::ball(shape_field(s.radius, "radius", s)?)
                         .translation(v(s.center.unwrap_or([0.0, 0.0]))),
@@ -700,8 +701,8 @@ mod rapier_sim {
                     other => return Err(format!("unknown shape type {other}").into()),
                 }
                 .collision_groups(groups(s)?)
-                .user_data(group_of(s) as u32 as u128)
-                .active_hooks(if group_of(s) != 0 {
+                .user_data(group as u32 as u128)
+                .active_hooks(if group != 0 {
                     hooks = true;
                     ActiveHooks::FILTER_CONTACT_PAIRS
                 } else {

@@ -592,6 +592,12 @@ fn finite2(path: &str, v: [f32; 2]) -> Result<(), Invalid> {
 impl SceneFile {
     /// Checks ranges and references; returns the path and message of the first problem.
     pub fn validate(&self) -> Result<(), Invalid> {
+        self.checked_geometries().map(|_| ())
+    }
+
+    /// [`SceneFile::validate`], keeping the engine shape of every shape (by body, then
+    /// shape) so that building does not make each one (polygon hulls included) twice.
+    fn checked_geometries(&self) -> Result<Vec<Vec<Shape>>, Invalid> {
         finite2("gravity", self.gravity)?;
         finite("dt", self.dt)?;
         if self.dt <= 0.0 || self.dt > 1.0 {
@@ -603,6 +609,7 @@ impl SceneFile {
         for (name, m) in &self.materials {
             validate_material(&format!("materials.{name}"), m)?;
         }
+        let mut geometries = Vec::with_capacity(self.bodies.len());
         for (i, b) in self.bodies.iter().enumerate() {
             let p = format!("bodies[{i}]");
             finite2(&format!("{p}.position"), b.position)?;
@@ -624,9 +631,10 @@ impl SceneFile {
                     return Err((format!("{p}.{field}"), format!("must not be negative (got {v})")));
                 }
             }
+            let mut shapes = Vec::with_capacity(b.shapes.len());
             for (j, s) in b.shapes.iter().enumerate() {
                 let sp = format!("{p}.shapes[{j}]");
-                self.shape_geometry(&sp, s)?;
+                shapes.push(self.shape_geometry(&sp, s)?);
                 match &s.material {
                     Some(MaterialRef::Named(n)) if !self.materials.contains_key(n) => {
                         let known: Vec<&str> = self.materials.keys().map(String::as_str).collect();
@@ -639,11 +647,12 @@ impl SceneFile {
                     _ => {}
                 }
             }
+            geometries.push(shapes);
         }
         for (i, j) in self.joints.iter().enumerate() {
             self.validate_joint(&format!("joints[{i}]"), j)?;
         }
-        Ok(())
+        Ok(geometries)
     }
 
     /// The index of the body a joint names, with errors at `path`.
@@ -836,7 +845,7 @@ impl SceneFile {
     /// order. Validates first: on an error nothing is added. A world-level error part way
     /// (the world refusing a body) leaves what was added so far.
     pub fn add_to(&self, world: &mut World) -> Result<Vec<BodyId>, SceneError> {
-        self.validate().map_err(|(path, message)| SceneError {
+        let geometries = self.checked_geometries().map_err(|(path, message)| SceneError {
             path,
             line: 0,
             column: 0,
@@ -851,7 +860,7 @@ impl SceneFile {
             }
         };
         let mut bodies = Vec::with_capacity(self.bodies.len());
-        for (i, b) in self.bodies.iter().enumerate() {
+        for ((i, b), shapes) in self.bodies.iter().enumerate().zip(&geometries) {
             let p = format!("bodies[{i}]");
             let def = BodyDef {
                 body_type: match b.kind {
@@ -875,20 +884,14 @@ impl SceneFile {
                 ..BodyDef::default()
             };
             let id = world.create_body(&def).map_err(to_err(p.clone()))?;
-            for (j, s) in b.shapes.iter().enumerate() {
+            for (j, (s, geometry)) in b.shapes.iter().zip(shapes).enumerate() {
                 let sp = format!("{p}.shapes[{j}]");
-                let geometry = self.shape_geometry(&sp, s).map_err(|(path, message)| SceneError {
-                    path,
-                    line: 0,
-                    column: 0,
-                    message,
-                })?;
                 let def = ShapeDef {
                     material: self.shape_material(s),
                     filter: s.filter.map(Into::into).unwrap_or_default(),
                     ..ShapeDef::default()
                 };
-                world.create_shape(id, &def, &geometry).map_err(to_err(sp))?;
+                world.create_shape(id, &def, geometry).map_err(to_err(sp))?;
             }
             // The velocity in the file is that of the centre of mass: set it after the
             // shapes moved the centre.

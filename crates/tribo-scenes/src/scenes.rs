@@ -1429,17 +1429,20 @@ pub fn ragdoll_rain() -> SceneFile {
     s.gravity = [0.0, -10.0];
     let mut ground = body(Some("ground".into()), BodyKind::Static, [0.0, 0.0], 0.0, Vec::new());
     for row in 0..RAGDOLL_RAIN_ROWS {
-        for i in 0..=500 {
-            let x = -125.0 + 0.5 * i as f32;
-            ground.shapes.push(offset_box(
-                RAGDOLL_SHELF_HALF,
-                RAGDOLL_SHELF_HALF,
-                [x, ragdoll_rain_shelf_y(row)],
-            ));
-        }
+        add_shelf(&mut ground, 250, ragdoll_rain_shelf_y(row));
     }
     s.bodies.push(ground);
     s
+}
+
+/// A shelf of the rain's boxes (half [`RAGDOLL_SHELF_HALF`]) centred at x = −0.5 k … 0.5 k
+/// for k = `half_count` (2k + 1 boxes), at height `y` [m].
+fn add_shelf(ground: &mut BodySpec, half_count: i32, y: f32) {
+    for i in -half_count..=half_count {
+        ground
+            .shapes
+            .push(offset_box(RAGDOLL_SHELF_HALF, RAGDOLL_SHELF_HALF, [0.5 * i as f32, y]));
+    }
 }
 
 /// Ten of the rain benchmark's ragdolls ([`ragdoll`]) in two groups of five (the five of a
@@ -1453,13 +1456,7 @@ pub fn ragdolls() -> SceneFile {
     );
     s.gravity = [0.0, -10.0];
     let mut ground = body(Some("shelf".into()), BodyKind::Static, [0.0, 0.0], 0.0, Vec::new());
-    for i in -20..=20 {
-        ground.shapes.push(offset_box(
-            RAGDOLL_SHELF_HALF,
-            RAGDOLL_SHELF_HALF,
-            [0.5 * i as f32, 0.0],
-        ));
-    }
+    add_shelf(&mut ground, 20, 0.0);
     s.bodies.push(ground);
     for x in [-3.0, 0.75] {
         for k in 0..RAGDOLL_RAIN_PER_GROUP {
