@@ -5,7 +5,7 @@
 //! step costs O(m log n) for m moved shapes among n. Pairs live as contacts until their
 //! fat boxes stop overlapping (checked in the narrow phase).
 
-use super::tree::DynamicTree;
+use super::tree::{DynamicTree, FlatTree};
 use crate::geometry::{Shape, SPECULATIVE_DISTANCE};
 use crate::math::Aabb;
 use std::collections::HashMap;
@@ -64,9 +64,30 @@ pub(crate) struct BroadPhase {
     /// Existing pairs: pair key → contact index. Used for lookups only, never iterated,
     /// so hash order cannot leak into the simulation.
     pub pairs: HashMap<u64, u32, BuildPairHasher>,
+    /// Query copies of the trees ([`FlatTree`]), made when a step queries many proxies.
+    pub flat: [FlatTree; 2],
 }
 
+/// A pair update that queries at least 1/`FLAT_QUERY_SHARE` of a tree's proxy count
+/// queries a [`FlatTree`] copy of it (made in O(n); it halves the node loads of a query).
+const FLAT_QUERY_SHARE: usize = 8;
+
 impl BroadPhase {
+    /// Makes the query copies of the trees current where `queries` queries pay for it (a
+    /// copy that is still current, as the static tree's mostly is, is kept); returns which
+    /// trees to query through their copy. Queries give the same overlaps either way.
+    pub fn prepare_queries(&mut self, queries: usize) -> [bool; 2] {
+        let mut use_flat = [false; 2];
+        for (k, (tree, flat)) in self.trees.iter().zip(self.flat.iter_mut()).enumerate() {
+            use_flat[k] = flat.is_copy_of(tree);
+            if !use_flat[k] && queries * FLAT_QUERY_SHARE >= tree.proxy_count() && tree.proxy_count() > 0 {
+                tree.flatten_into(flat);
+                use_flat[k] = true;
+            }
+        }
+        use_flat
+    }
+
     /// Inserts a proxy for a shape; returns its proxy id.
     pub fn create_proxy(&mut self, tree: u8, aabb: Aabb, category: u64, shape_index: u32) -> u32 {
         self.moved.push(shape_index);

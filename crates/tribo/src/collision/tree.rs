@@ -35,8 +35,9 @@ pub const NULL_NODE: u32 = u32::MAX;
 /// Height marker of a slot that sits on the free list.
 const FREE_HEIGHT: u32 = u32::MAX;
 
-/// Entries kept on the stack itself before a traversal spills to the heap.
-const STACK_FIXED: usize = 128;
+/// Pending nodes a traversal keeps in an array on the call stack; deeper trees walk on a
+/// `Vec` (a depth-first walk holds at most `height + 1` pending nodes).
+const STACK_FIXED: usize = 64;
 
 /// Default backtracking budget of the insertion search, see
 /// [`DynamicTree::set_insert_search_budget`].
@@ -113,46 +114,15 @@ struct Candidate {
     node: u32,
 }
 
-/// LIFO stack of node indices for traversals: a fixed array on the call stack, spilling to a
-/// `Vec` only when deeper than [`STACK_FIXED`] (a depth-first walk needs at most
-/// `height + 1` entries, so well-balanced trees never allocate).
-struct NodeStack {
-    fixed: [u32; STACK_FIXED],
-    len: usize,
-    spill: Vec<u32>,
-}
-
-impl NodeStack {
-    #[inline]
-    fn new() -> Self {
-        NodeStack {
-            fixed: [NULL_NODE; STACK_FIXED],
-            len: 0,
-            spill: Vec::new(),
-        }
-    }
-
-    #[inline]
-    fn push(&mut self, v: u32) {
-        if self.len < STACK_FIXED {
-            self.fixed[self.len] = v;
-            self.len += 1;
-        } else {
-            self.spill.push(v);
-        }
-    }
-
-    #[inline]
-    fn pop(&mut self) -> Option<u32> {
-        if let Some(v) = self.spill.pop() {
-            Some(v)
-        } else if self.len > 0 {
-            self.len -= 1;
-            Some(self.fixed[self.len])
-        } else {
-            None
-        }
-    }
+/// What a depth-first walk ([`DynamicTree::walk`]) does after visiting a node.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Walk {
+    /// Do not descend into this node's children.
+    Skip,
+    /// Visit this internal node's children.
+    Descend,
+    /// End the walk.
+    Stop,
 }
 
 /// Which local rotation [`DynamicTree::rotate`] applies at a node `A` with children `B`, `C`
@@ -188,6 +158,8 @@ pub struct DynamicTree {
     search: Vec<Candidate>,
     /// Maximum number of backtracking steps of the insertion search.
     search_budget: u32,
+    /// Counts the changes to the tree (a [`FlatTree`] made from it knows which one it is).
+    revision: u64,
 }
 
 impl Default for DynamicTree {
@@ -206,6 +178,7 @@ impl DynamicTree {
             proxy_count: 0,
             search: Vec::new(),
             search_budget: DEFAULT_SEARCH_BUDGET,
+            revision: 0,
         }
     }
 
@@ -232,6 +205,7 @@ impl DynamicTree {
     /// [`NULL_NODE`] when `aabb` is not valid (NaN/infinite or min > max) or the tree is
     /// full (2³² − 1 nodes); the tree is unchanged in that case.
     pub fn create_proxy(&mut self, aabb: Aabb, category_bits: u64, user_data: u64) -> u32 {
+        self.revision += 1;
         if !aabb.is_valid() {
             return NULL_NODE;
         }
@@ -255,6 +229,7 @@ impl DynamicTree {
 
     /// Removes a proxy. Returns false (and does nothing) when `proxy` is not a live proxy.
     pub fn destroy_proxy(&mut self, proxy: u32) -> bool {
+        self.revision += 1;
         if !self.is_proxy(proxy) {
             return false;
         }
@@ -268,6 +243,7 @@ impl DynamicTree {
     /// rotations). The id is unchanged. Returns false when `proxy` is not a live proxy or
     /// `aabb` is not valid.
     pub fn move_proxy(&mut self, proxy: u32, aabb: Aabb) -> bool {
+        self.revision += 1;
         if !self.is_proxy(proxy) || !aabb.is_valid() {
             return false;
         }
@@ -285,6 +261,7 @@ impl DynamicTree {
     /// tight. A proxy that left its neighbourhood is reinserted. Returns false when `proxy`
     /// is not a live proxy or `aabb` is not valid.
     pub fn move_proxy_near(&mut self, proxy: u32, aabb: Aabb) -> bool {
+        self.revision += 1;
         if !self.is_proxy(proxy) || !aabb.is_valid() {
             return false;
         }
@@ -323,6 +300,7 @@ impl DynamicTree {
     /// quality slowly degrades; call `move_proxy` now and then. Returns false when `proxy`
     /// is not a live proxy or `aabb` is not valid.
     pub fn enlarge_proxy(&mut self, proxy: u32, aabb: Aabb) -> bool {
+        self.revision += 1;
         if !self.is_proxy(proxy) || !aabb.is_valid() {
             return false;
         }
@@ -372,23 +350,55 @@ impl DynamicTree {
     /// counts) and whose `category_bits & mask_bits != 0`. The callback returns false to
     /// stop the query. Iterative (explicit stack), no allocation for trees of sane height.
     pub fn query<F: FnMut(u32, u64) -> bool>(&self, aabb: Aabb, mask_bits: u64, mut callback: F) {
-        if self.root == NULL_NODE {
-            return;
-        }
-        let mut stack = NodeStack::new();
-        stack.push(self.root);
-        while let Some(id) = stack.pop() {
-            let n = &self.nodes[id as usize];
+        self.walk(|id, n| {
             if n.category_bits & mask_bits == 0 || !n.aabb.overlaps(aabb) {
-                continue;
-            }
-            if n.is_leaf() {
-                if !callback(id, n.user_data) {
-                    return;
-                }
+                Walk::Skip
+            } else if !n.is_leaf() {
+                Walk::Descend
+            } else if callback(id, n.user_data) {
+                Walk::Skip
             } else {
-                stack.push(n.child2);
-                stack.push(n.child1);
+                Walk::Stop
+            }
+        });
+    }
+
+    /// Depth-first walk from the root, child 1 before child 2: `visit(id, node)` says
+    /// whether to descend into an internal node's children. A depth-first walk holds at
+    /// most `height + 1` pending nodes, so a tree lower than [`STACK_FIXED`] walks on an
+    /// array on the call stack and a deeper one on a `Vec` of that size; either way the
+    /// stack's length stays in a register (pair finding is bound by this loop: each pop
+    /// waits on the previous push, and a length kept in memory, as a stack that may spill
+    /// to the heap keeps it, adds a store-to-load round trip to every node).
+    #[inline(always)]
+    fn walk(&self, mut visit: impl FnMut(u32, &Node) -> Walk) {
+        let Some(root) = self.nodes.get(self.root as usize) else {
+            return;
+        };
+        let mut fixed = [NULL_NODE; STACK_FIXED];
+        let mut heap = Vec::new();
+        let stack: &mut [u32] = if (root.height as usize) < STACK_FIXED {
+            &mut fixed
+        } else {
+            heap.resize(root.height as usize + 2, NULL_NODE);
+            &mut heap
+        };
+        stack[0] = self.root;
+        let mut top = 1usize;
+        while let Some(next) = top.checked_sub(1) {
+            top = next;
+            let Some(&id) = stack.get(top) else { return };
+            let Some(n) = self.nodes.get(id as usize) else { continue };
+            match visit(id, n) {
+                Walk::Skip => {}
+                Walk::Stop => return,
+                Walk::Descend => {
+                    if let Some(slots) = stack.get_mut(top..top + 2) {
+                        slots[0] = n.child2;
+                        slots[1] = n.child1;
+                        top += 2;
+                    }
+                }
             }
         }
     }
@@ -434,12 +444,9 @@ impl DynamicTree {
             if d.y != 0.0 { 1.0 / d.y } else { 0.0 },
         );
 
-        let mut stack = NodeStack::new();
-        stack.push(self.root);
-        while let Some(id) = stack.pop() {
-            let n = &self.nodes[id as usize];
+        self.walk(|id, n| {
             if n.category_bits & mask_bits == 0 {
-                continue;
+                return Walk::Skip;
             }
             // Separating axis: the ray's normal. A small relative slack keeps this reject
             // conservative under rounding (the exact decision is the slab test below).
@@ -447,30 +454,26 @@ impl DynamicTree {
             let h = n.aabb.extents();
             let dist = normal.dot(p1 - c).abs();
             let reach = abs_normal.dot(h);
-            if dist - reach > 1e-5 * (dist + reach) {
-                continue;
+            if dist - reach > 1e-5 * (dist + reach) || !slab_hit(n.aabb, p1, d, inv, max_fraction) {
+                return Walk::Skip;
             }
-            if !slab_hit(n.aabb, p1, d, inv, max_fraction) {
-                continue;
+            if !n.is_leaf() {
+                return Walk::Descend;
             }
-            if n.is_leaf() {
-                let input = RayCastSubInput {
-                    origin,
-                    translation,
-                    max_fraction,
-                };
-                let value = callback(&input, id, n.user_data);
-                if value == 0.0 {
-                    return;
-                }
-                if 0.0 < value && value < max_fraction {
-                    max_fraction = value;
-                }
-            } else {
-                stack.push(n.child2);
-                stack.push(n.child1);
+            let input = RayCastSubInput {
+                origin,
+                translation,
+                max_fraction,
+            };
+            let value = callback(&input, id, n.user_data);
+            if value == 0.0 {
+                return Walk::Stop;
             }
-        }
+            if 0.0 < value && value < max_fraction {
+                max_fraction = value;
+            }
+            Walk::Skip
+        });
     }
 
     // ----------------------------------------------------------------------------------
@@ -606,6 +609,7 @@ impl DynamicTree {
     /// centroids coincide). Proxy ids, boxes and user data are unchanged; only internal
     /// nodes are recreated. O(n log n); allocates temporary buffers. Deterministic.
     pub fn rebuild(&mut self) {
+        self.revision += 1;
         let mut leaves: Vec<u32> = Vec::with_capacity(self.proxy_count);
         let mut free_slots: Vec<u32> = Vec::new();
         for (i, n) in self.nodes.iter().enumerate() {
@@ -1121,6 +1125,165 @@ fn slab_enter(b: Aabb, p: Vec2, d: Vec2, inv: Vec2, t_max: f32) -> Option<f32> {
     Some(t0)
 }
 
+// --------------------------------------------------------------------------------------
+// Flat copy for many queries in a row
+// --------------------------------------------------------------------------------------
+
+/// Link bit of a [`FlatNode`] child that is a leaf (the rest is the proxy id); without it
+/// the rest is the child's index in [`FlatTree::nodes`].
+const FLAT_LEAF: u32 = 1 << 31;
+
+/// One internal node of a [`FlatTree`]: its two children's boxes and category bits, so a
+/// query tests both children from this one cache line and loads only the children it
+/// descends into (the tree's own nodes hold their own box, so a walk loads every child
+/// of every node it enters just to test it: about half of its node loads rejected).
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct FlatNode {
+    boxes: [Aabb; 2],
+    categories: [u64; 2],
+    /// Per child: `FLAT_LEAF | proxy`, or the index of its flat node.
+    links: [u32; 2],
+}
+
+/// A read-only copy of a [`DynamicTree`] laid out for queries (see [`FlatNode`]): the
+/// internal nodes in depth-first order, child 1's subtree right after its parent, one
+/// cache line each; the leaves' user data in a parallel array. Made in O(n) by
+/// [`DynamicTree::flatten_into`]; worth it when a step queries most of the tree's proxies
+/// (piles in motion re-insert nearly every proxy every step).
+#[derive(Clone, Debug, Default)]
+pub struct FlatTree {
+    nodes: Vec<FlatNode>,
+    /// The user data of each node's two children (read only for leaf hits).
+    data: Vec<[u64; 2]>,
+    /// A tree of one leaf: its box, category bits, proxy id and user data.
+    single: Option<(Aabb, u64, u32, u64)>,
+    /// The copied tree's height.
+    height: usize,
+    /// The [`DynamicTree`] revision this copy was made from (`None`: never made).
+    revision: Option<u64>,
+}
+
+impl FlatTree {
+    /// Whether this is a copy of `tree` as it is now.
+    pub fn is_copy_of(&self, tree: &DynamicTree) -> bool {
+        self.revision == Some(tree.revision)
+    }
+
+    /// Calls `callback(proxy, user_data)` for every leaf whose box overlaps `aabb` and whose
+    /// category bits meet `mask_bits`, as [`DynamicTree::query`] on the tree it copies (the
+    /// same leaves; the order differs: a node's leaf children are reported before its
+    /// internal children are entered). The callback returns false to stop.
+    pub fn query<F: FnMut(u32, u64) -> bool>(&self, aabb: Aabb, mask_bits: u64, mut callback: F) {
+        if let Some((b, category, proxy, data)) = self.single {
+            if category & mask_bits != 0 && b.overlaps(aabb) {
+                callback(proxy, data);
+            }
+            return;
+        }
+        if self.nodes.is_empty() {
+            return;
+        }
+        // Depth-first: at most one pending sibling per level, so the tree's height bounds
+        // the stack (as in `DynamicTree::walk`).
+        let mut fixed = [0u32; STACK_FIXED];
+        let mut heap = Vec::new();
+        let stack: &mut [u32] = if self.height + 3 <= STACK_FIXED {
+            &mut fixed
+        } else {
+            heap.resize(self.height + 3, 0);
+            &mut heap
+        };
+        let mut top = 1usize;
+        while let Some(next) = top.checked_sub(1) {
+            top = next;
+            let Some(&i) = stack.get(top) else { return };
+            let Some(n) = self.nodes.get(i as usize) else { continue };
+            // Both children tested without branches (which child overlaps is data, not a
+            // pattern a predictor learns); internal ones pushed by writing the slot and
+            // advancing the top only on a hit, child 2 first so child 1 (next in memory)
+            // is walked first.
+            let hit = |c: usize| {
+                let b = n.boxes[c];
+                let apart =
+                    (aabb.min.x > b.max.x) | (aabb.min.y > b.max.y) | (b.min.x > aabb.max.x) | (b.min.y > aabb.max.y);
+                (n.categories[c] & mask_bits != 0) & !apart
+            };
+            let (hit1, hit2) = (hit(0), hit(1));
+            let (leaf1, leaf2) = (n.links[0] & FLAT_LEAF != 0, n.links[1] & FLAT_LEAF != 0);
+            for (link, push) in [(n.links[1], hit2 & !leaf2), (n.links[0], hit1 & !leaf1)] {
+                if let Some(slot) = stack.get_mut(top) {
+                    *slot = link;
+                    top += push as usize;
+                }
+            }
+            if (hit1 & leaf1) | (hit2 & leaf2) {
+                let Some(data) = self.data.get(i as usize) else {
+                    continue;
+                };
+                for (c, hit, leaf) in [(0, hit1, leaf1), (1, hit2, leaf2)] {
+                    if hit && leaf && !callback(n.links[c] & !FLAT_LEAF, data[c]) {
+                        return;
+                    }
+                }
+            }
+        }
+    }
+}
+
+impl DynamicTree {
+    /// Makes `out` a [`FlatTree`] copy of this tree (reusing its buffers).
+    pub fn flatten_into(&self, out: &mut FlatTree) {
+        out.nodes.clear();
+        out.data.clear();
+        out.single = None;
+        out.height = 0;
+        out.revision = Some(self.revision);
+        let Some(root) = self.nodes.get(self.root as usize) else {
+            return;
+        };
+        if root.is_leaf() {
+            out.single = Some((root.aabb, root.category_bits, self.root, root.user_data));
+            return;
+        }
+        out.height = root.height as usize;
+        // (tree node, flat parent and which of its links to point here); preorder with
+        // child 1 first, so child 1's subtree follows its parent in memory.
+        let mut pending: Vec<(u32, u32, usize)> = vec![(self.root, u32::MAX, 0)];
+        while let Some((id, parent, side)) = pending.pop() {
+            let Some(n) = self.nodes.get(id as usize) else { continue };
+            let at = out.nodes.len() as u32;
+            if let Some(p) = out.nodes.get_mut(parent as usize) {
+                p.links[side] = at;
+            }
+            let mut node = FlatNode {
+                boxes: [Aabb::new(Vec2::ZERO, Vec2::ZERO); 2],
+                categories: [0; 2],
+                links: [0; 2],
+            };
+            let mut data = [0u64; 2];
+            for (c, child) in [n.child1, n.child2].into_iter().enumerate() {
+                let Some(k) = self.nodes.get(child as usize) else {
+                    continue;
+                };
+                node.boxes[c] = k.aabb;
+                node.categories[c] = k.category_bits;
+                if k.is_leaf() {
+                    node.links[c] = FLAT_LEAF | child;
+                    data[c] = k.user_data;
+                }
+            }
+            out.nodes.push(node);
+            out.data.push(data);
+            for (c, child) in [(1, n.child2), (0, n.child1)] {
+                if self.nodes.get(child as usize).is_some_and(|k| !k.is_leaf()) {
+                    pending.push((child, at, c));
+                }
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1239,6 +1402,12 @@ mod tests {
             for &(id, b, _) in &live {
                 assert_eq!(t.fat_aabb(id), Some(b));
             }
+            // The flat copy answers every query as the tree does (same proxies, each with
+            // its own user data), and knows when the tree has changed since.
+            let mut flat = FlatTree::default();
+            assert!(!flat.is_copy_of(&t));
+            t.flatten_into(&mut flat);
+            assert!(flat.is_copy_of(&t));
             for _ in 0..20 {
                 let q = random_box(&mut r, 110.0, 30.0);
                 let mask = if r.below(2) == 0 {
@@ -1246,7 +1415,20 @@ mod tests {
                 } else {
                     1u64 << r.below(4) | 1u64 << r.below(4)
                 };
-                assert_eq!(query_sorted(&t, q, mask), brute_sorted(&live, q, mask));
+                let expected = brute_sorted(&live, q, mask);
+                assert_eq!(query_sorted(&t, q, mask), expected);
+                let mut got = Vec::new();
+                flat.query(q, mask, |id, data| {
+                    assert_eq!(t.user_data(id), Some(data));
+                    got.push(id);
+                    true
+                });
+                got.sort_unstable();
+                assert_eq!(got, expected, "flat copy, batch {batch}");
+            }
+            if let Some(&(id, b, _)) = live.first() {
+                assert!(t.move_proxy(id, b));
+                assert!(!flat.is_copy_of(&t), "a move makes the copy stale");
             }
         }
         // Quality after all the churn and after a rebuild, with queries still exact.
@@ -1647,6 +1829,33 @@ mod tests {
             );
             assert_eq!(x.aabb, y.aabb);
         }
+    }
+
+    #[test]
+    fn flat_copy_of_empty_and_single_leaf_trees() {
+        let mut t = DynamicTree::new();
+        let mut flat = FlatTree::default();
+        t.flatten_into(&mut flat);
+        flat.query(
+            Aabb::new(Vec2::new(-1e9, -1e9), Vec2::new(1e9, 1e9)),
+            u64::MAX,
+            |_, _| panic!("an empty tree has no leaves"),
+        );
+        let b = Aabb::new(Vec2::new(0.0, 0.0), Vec2::new(1.0, 1.0));
+        let id = t.create_proxy(b, 2, 77);
+        t.flatten_into(&mut flat);
+        let mut got = Vec::new();
+        flat.query(Aabb::new(Vec2::new(0.5, 0.5), Vec2::new(2.0, 2.0)), u64::MAX, |p, d| {
+            got.push((p, d));
+            true
+        });
+        flat.query(Aabb::new(Vec2::new(0.5, 0.5), Vec2::new(2.0, 2.0)), 1, |_, _| {
+            panic!("the mask excludes the leaf's category")
+        });
+        flat.query(Aabb::new(Vec2::new(1.5, 1.5), Vec2::new(2.0, 2.0)), u64::MAX, |_, _| {
+            panic!("apart")
+        });
+        assert_eq!(got, vec![(id, 77)]);
     }
 
     #[test]

@@ -101,7 +101,9 @@ impl World {
                 s.moved = true;
             }
         }
+        let use_flat = self.broad_phase.prepare_queries(moved.len());
         let mut new_pairs: Vec<u64> = Vec::new();
+        let mut hits: Vec<u32> = Vec::new();
         for &si in &moved {
             let Some(s) = self.shapes.at(si) else { continue };
             let Some(body) = self.bodies.at(s.body.index) else {
@@ -116,30 +118,42 @@ impl World {
             // tests come first, the bodies (for their types) only for a new pair.
             let exists = |key: u64| {
                 if body.contact_keys.len() <= SHORT_CONTACT_LIST {
-                    body.contact_keys.contains(&key)
+                    // Every key compared, no early exit: where the match sits is
+                    // unpredictable, a branch per key mispredicted.
+                    body.contact_keys.iter().fold(false, |found, &k| found | (k == key))
                 } else {
                     self.broad_phase.pairs.contains_key(&key)
                 }
             };
+            // The overlaps first (a small callback the walk inlines), then the pair tests.
+            hits.clear();
             for &tree in trees {
-                self.broad_phase.trees[tree as usize].query(s.fat_aabb, s.filter.mask, |_, data| {
-                    let other = data as u32;
-                    // An existing pair is found in the moved body's short key list before
-                    // the other shape's record is read (most overlaps are existing pairs).
-                    if other == si || exists(pair_key(si, other)) {
-                        return true;
-                    }
-                    let Some(o) = self.shapes.at(other) else { return true };
-                    // When both moved, the lower index reports the pair.
-                    if (o.moved && other < si) || o.body == s.body || !s.filter.should_collide(&o.filter) {
-                        return true;
-                    }
-                    let dynamic = body.is_dynamic() || self.bodies.at(o.body.index).is_some_and(|b| b.is_dynamic());
-                    if dynamic && (body.joints.is_empty() || !self.joint_blocks_pair(s.body.index, o.body.index)) {
-                        new_pairs.push(pair_key(si, other));
-                    }
+                let t = tree as usize;
+                let found = |_, data| {
+                    hits.push(data as u32);
                     true
-                });
+                };
+                if use_flat[t] {
+                    self.broad_phase.flat[t].query(s.fat_aabb, s.filter.mask, found);
+                } else {
+                    self.broad_phase.trees[t].query(s.fat_aabb, s.filter.mask, found);
+                }
+            }
+            for &other in &hits {
+                // An existing pair is found in the moved body's short key list before
+                // the other shape's record is read (most overlaps are existing pairs).
+                if other == si || exists(pair_key(si, other)) {
+                    continue;
+                }
+                let Some(o) = self.shapes.at(other) else { continue };
+                // When both moved, the lower index reports the pair.
+                if (o.moved && other < si) || o.body == s.body || !s.filter.should_collide(&o.filter) {
+                    continue;
+                }
+                let dynamic = body.is_dynamic() || self.bodies.at(o.body.index).is_some_and(|b| b.is_dynamic());
+                if dynamic && (body.joints.is_empty() || !self.joint_blocks_pair(s.body.index, o.body.index)) {
+                    new_pairs.push(pair_key(si, other));
+                }
             }
         }
         for &si in &moved {
