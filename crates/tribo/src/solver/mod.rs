@@ -287,6 +287,26 @@ pub(crate) fn prefetch<T>(x: &T) {
     let _ = x;
 }
 
+/// [`prefetch`] of only the first `lines` cache lines of `x` (a record whose hot part
+/// leads it).
+#[inline(always)]
+pub(crate) fn prefetch_lines<T>(x: &T, lines: usize) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use core::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let p = (x as *const T).cast::<i8>();
+        for line in (0..core::mem::size_of::<T>().min(64 * lines)).step_by(64) {
+            // SAFETY: as in `prefetch`.
+            #[allow(unsafe_code)]
+            unsafe {
+                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(line));
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (x, lines);
+}
+
 /// Spins (≈ a few microseconds) before a waiting thread yields its core.
 const SPINS_BEFORE_YIELD: u32 = 4000;
 
