@@ -27,8 +27,8 @@
 //! operations, so a contact solved wide or scalar gets the same numbers.
 
 use super::contact_solver::{
-    bounces, fresh_point_sticks, kinetic_energy_of, next_preload, ConstraintBodies, ConstraintPoint, ContactConstraint,
-    ContactInput, StepSoftness,
+    bounces, fresh_point_sticks, kinetic_energy_of, next_preload, shift_cap2, ConstraintBodies, ConstraintPoint,
+    ContactConstraint, ContactInput, StepSoftness,
 };
 use super::wide::{F4, LANES, M4, V4};
 use super::Softness;
@@ -80,6 +80,8 @@ pub(crate) struct WideHead {
     pub inv_mass_b: F4,
     pub inv_i_b: F4,
     pub split: F4,
+    /// `ContactConstraint::shift_cap2` of each lane (`contact_solver::capped_shift`).
+    pub shift_cap2: F4,
     pub points: [HeadPoint; 2],
     /// Friction impulse of the row (sum over the points) [N·s].
     pub tangent_impulse: F4,
@@ -190,6 +192,18 @@ fn lever_arms(c: &WideHead, d: V4, r_a: V4, r_b: V4) -> (V4, V4) {
     (r_a + d.scale(c.split), r_b - d.scale(one - c.split))
 }
 
+/// The relative displacement the lever arms follow (`contact_solver::capped_shift`, lane
+/// by lane; the square root only when some lane is over its cap).
+#[inline(always)]
+fn capped_shift(c: &WideHead, d: V4) -> V4 {
+    let d2 = d.x * d.x + d.y * d.y;
+    let over = d2.gt(c.shift_cap2);
+    if !over.any() {
+        return d;
+    }
+    d.scale(over.select((c.shift_cap2 / d2).sqrt(), F4::splat(1.0)))
+}
+
 #[inline(always)]
 fn relative_velocity(a: &WideBody, b: &WideBody, r_a: V4, r_b: V4) -> V4 {
     let vb = V4 {
@@ -223,13 +237,13 @@ fn anchor_displacement(a: &WideBody, b: &WideBody, d: V4, r_a: V4, r_b: V4) -> V
 pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
     let mut a = gather(states, &c.index_a);
     let mut b = gather(states, &c.index_b);
-    let d = b.dp - a.dp;
+    let shift = capped_shift(c, b.dp - a.dp);
     let n = c.normal;
     let t = V4 { x: n.y, y: -n.x };
     let mut arms = [(V4::default(), V4::default()); 2];
     for (i, arm) in arms.iter_mut().enumerate() {
         let p = &c.points[i];
-        *arm = lever_arms(c, d, p.r_a, p.r_b);
+        *arm = lever_arms(c, shift, p.r_a, p.r_b);
         c.points[i].substep_vn = relative_velocity(&a, &b, arm.0, arm.1).dot(n);
     }
     for (i, &(r_a, r_b)) in arms.iter().enumerate() {
@@ -258,6 +272,7 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     let mut a = gather(states, &h.index_a);
     let mut b = gather(states, &h.index_b);
     let d = b.dp - a.dp;
+    let shift = capped_shift(h, d);
     let n = h.normal;
     let zero = F4::ZERO;
     let one = F4::splat(1.0);
@@ -271,7 +286,7 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     let mut is = [zero; 2];
     for i in 0..2 {
         let (hp, p) = (&h.points[i], &c.points[i]);
-        arms[i] = lever_arms(h, d, hp.r_a, hp.r_b);
+        arms[i] = lever_arms(h, shift, hp.r_a, hp.r_b);
         let s = anchor_displacement(&a, &b, d, hp.r_a, hp.r_b).dot(n) + p.base_separation;
         let speculative = s.gt(zero);
         let (soft_bias, soft_ms, soft_is) = if USE_BIAS {
@@ -344,7 +359,7 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
 
     // Friction row (contact_solver::solve_friction).
     let t = V4 { x: n.y, y: -n.x };
-    let (r_a, r_b) = lever_arms(h, d, c.friction_r_a, c.friction_r_b);
+    let (r_a, r_b) = lever_arms(h, shift, c.friction_r_a, c.friction_r_b);
     let mu = c.stick.select(c.mu_s, c.mu_d);
     let limit = mu * (new0 + new1);
     let vt = relative_velocity(&a, &b, r_a, r_b).dot(t) - c.tangent_speed;
@@ -513,6 +528,7 @@ pub(crate) fn build_group<S: StateRead>(
     let inv_or_zero = |k: F4| k.gt(zero).select(one / k, zero);
     let sum = ma + mb;
     hd.split = sum.gt(zero).select(mb / sum, half);
+    hd.shift_cap2 = F4(core::array::from_fn(|l| shift_cap2(ma.0[l], ia.0[l], mb.0[l], ib.0[l])));
     let k_roll = ia + ib;
     out.rolling_mass = inv_or_zero(k_roll);
     let mut arms = [(V4::default(), V4::default()); 2];
@@ -588,13 +604,14 @@ pub(crate) fn store_group<S: StateRead>(
     let a = gather(states, &h.index_a);
     let b = gather(states, &h.index_b);
     let d = b.dp - a.dp;
+    let shift = capped_shift(h, d);
     let n = h.normal;
     let t = V4 { x: n.y, y: -n.x };
     let mut vt = [F4::ZERO; 2];
     let mut disp = [F4::ZERO; 2];
     for i in 0..2 {
         let p = &h.points[i];
-        let (r_a, r_b) = lever_arms(h, d, p.r_a, p.r_b);
+        let (r_a, r_b) = lever_arms(h, shift, p.r_a, p.r_b);
         vt[i] = relative_velocity(&a, &b, r_a, r_b).dot(t) - w.tangent_speed;
         disp[i] = anchor_displacement(&a, &b, d, p.r_a, p.r_b).dot(t);
     }
@@ -706,6 +723,7 @@ pub(crate) fn pack(
     h.inv_mass_b.0[l] = cc.inv_mass_b;
     h.inv_i_b.0[l] = cc.inv_i_b;
     h.split.0[l] = cc.split;
+    h.shift_cap2.0[l] = cc.shift_cap2;
     w.mu_s.0[l] = cc.mu_s;
     w.mu_d.0[l] = cc.mu_d;
     w.tangent_speed.0[l] = cc.tangent_speed;
@@ -869,6 +887,7 @@ pub(crate) fn unpack_full(h: &WideHead, w: &WideContact, cold: &WideCold, l: usi
         },
         block,
         split: h.split.0[l],
+        shift_cap2: h.shift_cap2.0[l],
         kinetic_energy: cold.kinetic_energy[l],
         height: cold.height[l],
         patch_tangent_mass: if count == 2 { w.tangent_mass.0[l] } else { 0.0 },

@@ -58,6 +58,12 @@ impl F4 {
         self.max(lo).min(hi)
     }
 
+    /// Lane-wise square root (IEEE, as `f32::sqrt`).
+    #[inline(always)]
+    pub fn sqrt(self) -> F4 {
+        F4(lanes!(|i| self.0[i].sqrt()))
+    }
+
     #[inline(always)]
     pub fn abs(self) -> F4 {
         F4(lanes!(|i| f32::from_bits(self.0[i].to_bits() & 0x7fff_ffff)))
@@ -92,6 +98,12 @@ impl M4 {
     #[inline(always)]
     pub fn lane(self, i: usize) -> bool {
         self.0[i] != 0
+    }
+
+    /// Whether some lane is true.
+    #[inline(always)]
+    pub fn any(self) -> bool {
+        (self.0[0] | self.0[1] | self.0[2] | self.0[3]) != 0
     }
 
     /// Whether every lane is true.
