@@ -4,7 +4,7 @@
 //! solver copies of these records; [`crate::world`] owns them.
 
 use crate::error::{check_finite, check_non_negative, check_vec, Result};
-use crate::math::{Transform, Vec2};
+use crate::math::{Rot, Transform, Vec2};
 use crate::world::ShapeId;
 
 /// How a body moves.
@@ -130,8 +130,10 @@ pub(crate) struct Body {
     pub center: Vec2,
     /// Centre of mass in the body frame [m].
     pub local_center: Vec2,
-    /// Centre of mass and rotation at the start of the last step (sleep metric).
+    /// Centre of mass and rotation at the start of the last step (sleep metric; with them
+    /// finalize knows the step's motion, for continuous collision).
     pub center0: Vec2,
+    pub q0: Rot,
     pub v: Vec2,
     pub w: f32,
     pub mass: f32,
@@ -180,6 +182,7 @@ impl Body {
             center: def.position,
             local_center: Vec2::ZERO,
             center0: def.position,
+            q0: xf.q,
             v: if moving { def.linear_velocity } else { Vec2::ZERO },
             w: if moving { def.angular_velocity } else { 0.0 },
             mass: 0.0,

@@ -14,6 +14,7 @@ mod manifold;
 mod mass;
 mod raycast;
 mod shapes;
+mod sweep;
 
 pub use hull::convex_hull;
 pub(crate) use manifold::collide_bounded;
@@ -21,6 +22,7 @@ pub use manifold::{collide, collide_after, Manifold, ManifoldPoint, MAX_MANIFOLD
 pub use mass::MassData;
 pub use raycast::{RayCastInput, RayHit};
 pub use shapes::{Capsule, Circle, Polygon, Segment, Shape, MAX_POLYGON_VERTICES};
+pub(crate) use sweep::{first_contact, Sweep};
 
 use core::fmt;
 

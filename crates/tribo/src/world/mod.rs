@@ -10,6 +10,7 @@ mod joints;
 mod profile;
 mod query;
 mod step;
+mod sweep;
 
 pub use events::{ContactBeginEvent, ContactEndEvent, ContactEvents, ContactInfo, ContactPointInfo};
 pub use ids::{BodyId, JointId, ShapeId};
@@ -404,6 +405,7 @@ impl World {
         b.xf = Transform::new(position, angle);
         b.center = b.xf.apply(b.local_center);
         b.center0 = b.center;
+        b.q0 = b.xf.q;
         self.wake_body(id.index);
         self.refresh_body_proxies(id.index, 0.0);
         Ok(())
@@ -802,8 +804,13 @@ impl World {
     }
 
     /// Updates the fat boxes of a body's shapes after its pose changed.
-    /// `dt` > 0 also sweeps the boxes along the body's velocity for the next step.
+    /// `dt` > 0 (a step's finalize) also sweeps the boxes along the body's velocity for the
+    /// next step, and first stops a dynamic body that moved out of the region its pairs
+    /// covered at the first static shape in its way ([`World::stop_at_static_shapes`]).
     pub(crate) fn refresh_body_proxies(&mut self, body_index: u32, dt: f32) {
+        if dt > 0.0 && self.left_its_pairs(body_index) {
+            self.stop_at_static_shapes(body_index);
+        }
         // Disjoint field borrows: no copy of the shape list in this per-step path.
         let Some(b) = self.bodies.at(body_index) else { return };
         // The solver never moves a body faster than the world's speed limit; a velocity

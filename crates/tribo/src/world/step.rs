@@ -541,6 +541,7 @@ impl World {
             b.v = s.v;
             b.w = s.w;
             b.center0 = b.center;
+            b.q0 = b.xf.q;
             b.center += s.dp;
             let q = s.dq.mul(b.xf.q);
             // Renormalise against slow drift of |q| over many steps.

@@ -1,0 +1,116 @@
+//! Continuous collision against static shapes for bodies that moved further in a step
+//! than their pairs covered (see [`crate::geometry::first_contact`]).
+//!
+//! The pairs a body is solved with come from its fat boxes at the start of the step,
+//! swept along its velocity then. An impulse inside the step can send it much further:
+//! in Box2D's spinner a box the rotor's tip hits at 70 m/s is kicked 0.7 m into the ring's
+//! wall in one step, where it has no pair; it ends in the seam between two wall pieces and
+//! their side faces push it out through the wall at 240 m/s. Such a body is stopped where
+//! it first touches a static shape along its motion, as Box2D v3 stops fast bodies at
+//! their time of impact against static shapes; its velocity is kept, and the next step's
+//! pairs and speculative contact take it from there.
+
+use super::{BodyType, World};
+use crate::collision::broad_phase::STATIC_TREE;
+use crate::collision::contact::pair_key;
+use crate::dynamics::body::Body;
+use crate::geometry::{first_contact, Sweep, SPECULATIVE_DISTANCE};
+
+impl World {
+    /// Whether a dynamic body's shapes left, at their pose after this step's solve, the fat
+    /// boxes its pairs were found with. Cheap for slow bodies: a body whose points moved
+    /// less than the speculative distance stays inside (each fat box holds its shape's box
+    /// grown by that distance at the step's start pose).
+    pub(crate) fn left_its_pairs(&self, body_index: u32) -> bool {
+        let Some(b) = self.bodies.at(body_index) else {
+            return false;
+        };
+        if b.body_type != BodyType::Dynamic {
+            return false;
+        }
+        let sweep = step_motion(b);
+        if !(sweep.travel(b.max_extent) > SPECULATIVE_DISTANCE) {
+            return false;
+        }
+        b.shapes.iter().any(|sid| {
+            self.shapes
+                .get(sid.index, sid.generation)
+                .is_some_and(|s| !s.fat_aabb.contains(s.geometry.aabb(b.xf)))
+        })
+    }
+
+    /// Moves a body back along this step's motion to where it first overlaps, by more than
+    /// the linear slop, a static shape it may collide with (filters and joints respected)
+    /// and had no pair with this step. Its velocity is unchanged.
+    pub(crate) fn stop_at_static_shapes(&mut self, body_index: u32) {
+        let Some(b) = self.bodies.at(body_index) else { return };
+        let sweep = step_motion(b);
+        let (start, end) = (sweep.at(0.0), sweep.at(1.0));
+        let tree = &self.broad_phase.trees[STATIC_TREE as usize];
+        let mut first = 1.0f32;
+        for &sid in &b.shapes {
+            let Some(s) = self.shapes.get(sid.index, sid.generation) else {
+                continue;
+            };
+            // Every pose of the motion: the end boxes, grown by the most a point strays
+            // from the chord between its two end positions during the turn.
+            let reach = s.geometry.max_extent(b.local_center);
+            let swept = s
+                .geometry
+                .aabb(start)
+                .union(s.geometry.aabb(end))
+                .expand(sweep_bulge(&sweep, reach));
+            let mut found: Vec<u32> = Vec::new();
+            tree.query(swept, s.filter.mask, |_, data| {
+                found.push(data as u32);
+                true
+            });
+            for other in found {
+                // A pair that exists was in this step's narrow phase and solve, with a
+                // speculative margin for the motion the step began with.
+                if b.contact_keys.contains(&pair_key(sid.index, other)) {
+                    continue;
+                }
+                let Some(o) = self.shapes.at(other) else { continue };
+                if !s.filter.should_collide(&o.filter) {
+                    continue;
+                }
+                if !b.joints.is_empty() && self.joint_blocks_pair(body_index, o.body.index) {
+                    continue;
+                }
+                let Some(ob) = self.bodies.at(o.body.index) else {
+                    continue;
+                };
+                if let Some(t) = first_contact(&o.geometry, ob.xf, &s.geometry, &sweep) {
+                    first = first.min(t);
+                }
+            }
+        }
+        if first < 1.0 {
+            let xf = sweep.at(first);
+            if let Some(b) = self.bodies.at_mut(body_index) {
+                b.xf = xf;
+                b.center = xf.apply(b.local_center);
+            }
+        }
+    }
+}
+
+/// A body's motion over the step just solved (from its start pose `center0`, `q0`).
+fn step_motion(b: &Body) -> Sweep {
+    Sweep {
+        local_center: b.local_center,
+        c0: b.center0,
+        c1: b.center,
+        q0: b.q0,
+        q1: b.xf.q,
+    }
+}
+
+/// How far [m] a point at distance `reach` from the centre of mass strays, during the
+/// sweep's turn, from the straight line between its start and end positions: the sagitta
+/// of its arc, reach·(1 − cos(Δθ/2)) ≤ ½·reach·|q1 − q0| (the chord).
+fn sweep_bulge(sweep: &Sweep, reach: f32) -> f32 {
+    let chord = sweep.travel(reach) - (sweep.c1 - sweep.c0).length();
+    0.5 * chord
+}
