@@ -751,7 +751,14 @@ fn narrow_phase(c: &mut Contact, bodies: &Arena<Body>, shapes: &Arena<ShapeRecor
             changed: false,
         };
     }
-    let now = c.recycle(ba.xf, bb.xf, 2.0 * ba.max_extent.min(bb.max_extent))
+    // A recycled manifold keeps its points, not the speculative ones a margin grown by the
+    // pair's motion would add (a corner swinging towards a wall), so only a pair moving
+    // less than the speculative distance per step may keep it: a feature it lacks was
+    // further than that distance less the recycle distance when it was made, and closes by
+    // at most the speculative distance in the step, so it can overlap by the linear slop
+    // at most. Faster pairs are collided again (Box2D's fast bodies bypass recycling too).
+    let slow = dt * rel <= SPECULATIVE_DISTANCE;
+    let now = (slow && c.recycle(ba.xf, bb.xf, 2.0 * ba.max_extent.min(bb.max_extent)))
         || c.update(&sa.geometry, ba.xf, &sb.geometry, bb.xf, margin);
     if !now && c.far_bound > 0.0 {
         c.far = FarPoses {
