@@ -26,7 +26,7 @@ use crate::dynamics::body::Body;
 use crate::dynamics::shape::ShapeRecord;
 use crate::dynamics::{BodyDef, BodyType, Filter, Material, ShapeDef};
 use crate::error::{check_finite, check_non_negative, check_positive, check_vec, Error, Result};
-use crate::geometry::{Shape, SPECULATIVE_DISTANCE};
+use crate::geometry::{Shape, LINEAR_SLOP, SPECULATIVE_DISTANCE};
 use crate::math::{Aabb, Transform, Vec2};
 use crate::solver::contact_set::{Candidate, ContactSolver};
 use crate::solver::{BodySim, BodyState};
@@ -808,21 +808,43 @@ impl World {
     /// next step, and first stops a dynamic body that moved out of the region its pairs
     /// covered at the first static shape in its way ([`World::stop_at_static_shapes`]).
     pub(crate) fn refresh_body_proxies(&mut self, body_index: u32, dt: f32) {
-        if dt > 0.0 && self.left_its_pairs(body_index) {
-            self.stop_at_static_shapes(body_index);
+        if let Some(escaped) = self.refresh_boxes(body_index, dt, 0, true) {
+            // A shape ended the step outside the fat box its pairs were found with.
+            let moved = self.stop_at_static_shapes(body_index);
+            self.refresh_boxes(body_index, dt, if moved { 0 } else { escaped }, false);
         }
+    }
+
+    /// [`World::refresh_body_proxies`]' box update, from the body's `first` shape on. With
+    /// `check` (and `dt` > 0, for a dynamic body) it first compares each shape's box at the
+    /// body's new pose with the fat box its pairs were found with, and stops at the first
+    /// one that left it by more than the speculative distance plus the slop, returning its
+    /// position in the body's shape list (the shapes before it are updated); the box is
+    /// computed once either way.
+    fn refresh_boxes(&mut self, body_index: u32, dt: f32, first: usize, check: bool) -> Option<usize> {
         // Disjoint field borrows: no copy of the shape list in this per-step path.
-        let Some(b) = self.bodies.at(body_index) else { return };
+        let Some(b) = self.bodies.at(body_index) else {
+            return None;
+        };
+        let check = check && dt > 0.0 && b.body_type == BodyType::Dynamic;
         // The solver never moves a body faster than the world's speed limit; a velocity
         // above it (left by the last pass of a violent step) must not sweep a box across
         // the world, which would pair it with every shape.
         let (xf, speed, limit) = (b.xf, b.v.length(), self.def.max_linear_speed);
         let v = if speed > limit { b.v * (limit / speed) } else { b.v };
-        for &sid in &b.shapes {
+        for (k, &sid) in b.shapes.iter().enumerate().skip(first) {
             let Some(s) = self.shapes.get_mut(sid.index, sid.generation) else {
                 continue;
             };
-            let aabb = shape_box(&s.geometry, xf, v, dt, s.sweep_free);
+            let tight = s.geometry.aabb(xf);
+            // A static shape the body has no pair with had its fat box (its box grown by
+            // the speculative distance) apart from this one's, so a shape poking out of its
+            // fat box by less than the speculative distance plus the slop overlaps it by the
+            // slop at most: only a shape further out can be where nothing stopped it.
+            if check && !s.fat_aabb.expand(SPECULATIVE_DISTANCE + LINEAR_SLOP).contains(tight) {
+                return Some(k);
+            }
+            let aabb = swept_box(tight, v, dt, s.sweep_free);
             s.aabb = aabb;
             if !s.fat_aabb.contains(aabb) || dt == 0.0 {
                 let fat = aabb.expand(s.margin);
@@ -831,6 +853,7 @@ impl World {
                 self.broad_phase.move_proxy(tree, proxy, fat, sid.index);
             }
         }
+        None
     }
 
     /// Wakes a sleeping body and its whole sleeping island.
@@ -965,7 +988,12 @@ impl World {
 /// `SPECULATIVE_DISTANCE` of the motion, so the sweep is that much shorter and still
 /// holds every pose of the step.
 pub(crate) fn shape_box(geometry: &Shape, xf: Transform, v: Vec2, dt: f32, free: f32) -> Aabb {
-    let aabb = geometry.aabb(xf).expand(SPECULATIVE_DISTANCE);
+    swept_box(geometry.aabb(xf), v, dt, free)
+}
+
+/// [`shape_box`] from the shape's tight box at its pose.
+fn swept_box(tight: Aabb, v: Vec2, dt: f32, free: f32) -> Aabb {
+    let aabb = tight.expand(SPECULATIVE_DISTANCE);
     let motion = v.length() * dt;
     if dt > 0.0 && motion > free.max(SPECULATIVE_DISTANCE) {
         let d = v * (dt * (1.0 - SPECULATIVE_DISTANCE / motion));

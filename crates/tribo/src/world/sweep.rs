@@ -10,56 +10,36 @@
 //! their time of impact against static shapes; its velocity is kept, and the next step's
 //! pairs and speculative contact take it from there.
 
-use super::{BodyType, World};
+use super::World;
 use crate::collision::broad_phase::STATIC_TREE;
 use crate::collision::contact::pair_key;
 use crate::dynamics::body::Body;
-use crate::geometry::{first_contact, Sweep, SPECULATIVE_DISTANCE};
+use crate::geometry::{first_contact, Sweep};
 
 impl World {
-    /// Whether a dynamic body's shapes left, at their pose after this step's solve, the fat
-    /// boxes its pairs were found with. Cheap for slow bodies: a body whose points moved
-    /// less than the speculative distance stays inside (each fat box holds its shape's box
-    /// grown by that distance at the step's start pose).
-    pub(crate) fn left_its_pairs(&self, body_index: u32) -> bool {
+    /// Moves a body back along this step's motion to where it first overlaps, by more than
+    /// the linear slop, a static shape it may collide with (filters and joints respected)
+    /// and had no pair with this step. Its velocity is unchanged. Returns whether it moved.
+    pub(crate) fn stop_at_static_shapes(&mut self, body_index: u32) -> bool {
+        let tree = &self.broad_phase.trees[STATIC_TREE as usize];
         let Some(b) = self.bodies.at(body_index) else {
             return false;
         };
-        if b.body_type != BodyType::Dynamic {
+        if tree.proxy_count() == 0 {
             return false;
         }
         let sweep = step_motion(b);
-        if !(sweep.travel(b.max_extent) > SPECULATIVE_DISTANCE) {
-            return false;
-        }
-        b.shapes.iter().any(|sid| {
-            self.shapes
-                .get(sid.index, sid.generation)
-                .is_some_and(|s| !s.fat_aabb.contains(s.geometry.aabb(b.xf)))
-        })
-    }
-
-    /// Moves a body back along this step's motion to where it first overlaps, by more than
-    /// the linear slop, a static shape it may collide with (filters and joints respected)
-    /// and had no pair with this step. Its velocity is unchanged.
-    pub(crate) fn stop_at_static_shapes(&mut self, body_index: u32) {
-        let Some(b) = self.bodies.at(body_index) else { return };
-        let sweep = step_motion(b);
-        let (start, end) = (sweep.at(0.0), sweep.at(1.0));
-        let tree = &self.broad_phase.trees[STATIC_TREE as usize];
+        let bulge = sweep_bulge(&sweep, b.max_extent);
         let mut first = 1.0f32;
         for &sid in &b.shapes {
             let Some(s) = self.shapes.get(sid.index, sid.generation) else {
                 continue;
             };
-            // Every pose of the motion: the end boxes, grown by the most a point strays
-            // from the chord between its two end positions during the turn.
-            let reach = s.geometry.max_extent(b.local_center);
-            let swept = s
-                .geometry
-                .aabb(start)
-                .union(s.geometry.aabb(end))
-                .expand(sweep_bulge(&sweep, reach));
+            // Every pose of the motion: the box at the start pose (the shape's box from the
+            // last refresh holds it) and at the end pose, grown by the most a point strays
+            // from the chord between its two end positions during the turn (the body's
+            // reach bounds each shape's).
+            let swept = s.aabb.union(s.geometry.aabb(b.xf)).expand(bulge);
             let mut found: Vec<u32> = Vec::new();
             tree.query(swept, s.filter.mask, |_, data| {
                 found.push(data as u32);
@@ -91,8 +71,10 @@ impl World {
             if let Some(b) = self.bodies.at_mut(body_index) {
                 b.xf = xf;
                 b.center = xf.apply(b.local_center);
+                return true;
             }
         }
+        false
     }
 }
 
