@@ -58,8 +58,13 @@ impl Sweep {
     /// step [m] (straight motion plus the chord of the turn, 2·reach·sin(Δθ/2) =
     /// reach·|q1 − q0|).
     pub fn travel(&self, reach: f32) -> f32 {
-        let dq = Vec2::new(self.q1.c - self.q0.c, self.q1.s - self.q0.s);
-        (self.c1 - self.c0).length() + reach * dq.length()
+        (self.c1 - self.c0).length() + self.chord(reach)
+    }
+
+    /// The chord [m] of the turn of a point at distance `reach` from the centre of mass,
+    /// 2·reach·sin(Δθ/2) = reach·|q1 − q0|.
+    pub fn chord(&self, reach: f32) -> f32 {
+        reach * Vec2::new(self.q1.c - self.q0.c, self.q1.s - self.q0.s).length()
     }
 }
 

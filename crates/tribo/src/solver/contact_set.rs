@@ -524,12 +524,7 @@ impl ContactSolver {
                     continue;
                 };
                 match this.slots.get(first + k) {
-                    Some(&Slot::Wide { group, lane }) => {
-                        let s = &this.stored[group as usize][lane as usize];
-                        let n = s.count as usize;
-                        c.points[..n].copy_from_slice(&s.points[..n]);
-                        c.rolling_impulse = s.rolling_impulse;
-                    }
+                    Some(&Slot::Wide { group, lane }) => this.stored[group as usize][lane as usize].write_into(c),
                     Some(&Slot::Overflow(o)) => {
                         if let Some(oc) = this.overflow.get(o as usize) {
                             store_impulses(oc, c, states, ctx);
@@ -540,7 +535,7 @@ impl ContactSolver {
             }
         };
         let candidates = &self.contact_of;
-        if !ctx.parallel || !self.contacts_ascend || candidates.len() <= CONTACT_STORE_CHUNK {
+        if !self.contacts_ascend || candidates.len() <= CONTACT_STORE_CHUNK {
             store_run(0, candidates, 0, contacts);
             return;
         }
@@ -589,9 +584,7 @@ impl ContactSolver {
                     continue; // an empty lane
                 }
                 if let Some(Some(c)) = contacts.get_mut(contact as usize) {
-                    let n = s.count as usize;
-                    c.points[..n].copy_from_slice(&s.points[..n]);
-                    c.rolling_impulse = s.rolling_impulse;
+                    s.write_into(c);
                 }
             }
         }

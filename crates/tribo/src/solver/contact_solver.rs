@@ -1228,19 +1228,7 @@ mod tests {
     /// geometrically; [`capped_shift`] keeps the ratio near 1.
     #[test]
     fn relax_passes_converge_when_bodies_slid_far_within_the_step() {
-        let ctx = StepContext {
-            dt: 1.0 / 60.0,
-            h: 1.0 / 240.0,
-            inv_h: 240.0,
-            substeps: 4,
-            contact_hertz: 30.0,
-            contact_damping_ratio: 10.0,
-            push_speed: 3.0,
-            stick_speed: 0.01,
-            max_linear_speed: 400.0,
-            warm_starting: true,
-            parallel: false,
-        };
+        let ctx = StepContext::for_tests();
         let (m, half) = (0.1f32, 0.35f32);
         let inertia = m * (2.0 * half) * (2.0 * half) * 2.0 / 12.0;
         let bodies = ConstraintBodies {

@@ -33,7 +33,7 @@ use super::contact_solver::{
 use super::wide::{F4, LANES, M4, V4};
 use super::Softness;
 use super::{StateCell, StateRead, StepContext};
-use crate::collision::contact::{FrictionState, PointState};
+use crate::collision::contact::{Contact, FrictionState, PointState};
 use crate::math::Vec2;
 
 /// Number of colours (Box2D v3 uses 24, the last for overflow).
@@ -589,6 +589,17 @@ pub(crate) struct StoredContact {
     pub count: u8,
 }
 
+impl StoredContact {
+    /// Writes what it holds into its contact (the manifold's points and the rolling
+    /// impulse).
+    #[inline]
+    pub(crate) fn write_into(&self, c: &mut Contact) {
+        let n = (self.count as usize).min(self.points.len());
+        c.points[..n].copy_from_slice(&self.points[..n]);
+        c.rolling_impulse = self.rolling_impulse;
+    }
+}
+
 /// The store stage for four constraints, in group order: exactly what
 /// `contact_solver::store_impulses` computes for each lane (the end-of-step slip velocity
 /// and anchor displacement four lanes at a time, the sums and the stick/slip transitions
@@ -988,19 +999,7 @@ mod tests {
     }
 
     fn fixture() -> Fixture {
-        let ctx = StepContext {
-            dt: 1.0 / 60.0,
-            h: 1.0 / 240.0,
-            inv_h: 240.0,
-            substeps: 4,
-            contact_hertz: 30.0,
-            contact_damping_ratio: 10.0,
-            push_speed: 3.0,
-            stick_speed: 0.01,
-            max_linear_speed: 400.0,
-            warm_starting: true,
-            parallel: false,
-        };
+        let ctx = StepContext::for_tests();
         let soft = StepSoftness::new(&ctx);
         let state = |vx: f32, w: f32| BodyState {
             v: Vec2::new(vx, -0.5),

@@ -270,21 +270,7 @@ impl SpinBarrier {
 /// faults and changes no result.
 #[inline(always)]
 pub(crate) fn prefetch<T>(x: &T) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use core::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        let p = (x as *const T).cast::<i8>();
-        for line in (0..core::mem::size_of::<T>()).step_by(64) {
-            // SAFETY: a prefetch reads nothing and cannot fault; the address is inside
-            // (or one line past the start of) a live reference. SSE is part of x86_64.
-            #[allow(unsafe_code)]
-            unsafe {
-                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(line));
-            }
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
+    prefetch_lines(x, core::mem::size_of::<T>().div_ceil(64));
 }
 
 /// [`prefetch`] of only the first `lines` cache lines of `x` (a record whose hot part
@@ -296,7 +282,8 @@ pub(crate) fn prefetch_lines<T>(x: &T, lines: usize) {
         use core::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
         let p = (x as *const T).cast::<i8>();
         for line in (0..core::mem::size_of::<T>().min(64 * lines)).step_by(64) {
-            // SAFETY: as in `prefetch`.
+            // SAFETY: a prefetch reads nothing and cannot fault; the address is inside a
+            // live reference. SSE is part of x86_64.
             #[allow(unsafe_code)]
             unsafe {
                 _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(line));
@@ -378,6 +365,26 @@ pub(crate) struct SolverBody {
     pub inv_i: f32,
     /// World centre of mass [m].
     pub center: Vec2,
+}
+
+#[cfg(test)]
+impl StepContext {
+    /// Box2D's defaults at 60 Hz with 4 substeps, one thread (solver unit tests).
+    pub(crate) fn for_tests() -> StepContext {
+        StepContext {
+            dt: 1.0 / 60.0,
+            h: 1.0 / 240.0,
+            inv_h: 240.0,
+            substeps: 4,
+            contact_hertz: 30.0,
+            contact_damping_ratio: 10.0,
+            push_speed: 3.0,
+            stick_speed: 0.01,
+            max_linear_speed: 400.0,
+            warm_starting: true,
+            parallel: false,
+        }
+    }
 }
 
 /// Tunable numbers of the solver, fixed for one step.

@@ -116,15 +116,6 @@ impl World {
             };
             // Most boxes a moved shape overlaps already have their contact: the cheap
             // tests come first, the bodies (for their types) only for a new pair.
-            let exists = |key: u64| {
-                if body.contact_keys.len() <= SHORT_CONTACT_LIST {
-                    // Every key compared, no early exit: where the match sits is
-                    // unpredictable, a branch per key mispredicted.
-                    body.contact_keys.iter().fold(false, |found, &k| found | (k == key))
-                } else {
-                    self.broad_phase.pairs.contains_key(&key)
-                }
-            };
             // The overlaps first (a small callback the walk inlines), then the pair tests.
             hits.clear();
             for &tree in trees {
@@ -142,7 +133,7 @@ impl World {
             for &other in &hits {
                 // An existing pair is found in the moved body's short key list before
                 // the other shape's record is read (most overlaps are existing pairs).
-                if other == si || exists(pair_key(si, other)) {
+                if other == si || self.pair_exists(body, pair_key(si, other)) {
                     continue;
                 }
                 let Some(o) = self.shapes.at(other) else { continue };
@@ -167,6 +158,18 @@ impl World {
         new_pairs.dedup();
         for key in new_pairs {
             self.create_contact((key >> 32) as u32, key as u32);
+        }
+    }
+
+    /// Whether the pair with `key` has a contact, `body` being one of its bodies: found in
+    /// the body's short key list before the world's pair table (every key compared, no
+    /// early exit: where the match sits is unpredictable, a branch per key mispredicted).
+    #[inline]
+    pub(crate) fn pair_exists(&self, body: &Body, key: u64) -> bool {
+        if body.contact_keys.len() <= SHORT_CONTACT_LIST {
+            body.contact_keys.iter().fold(false, |found, &k| found | (k == key))
+        } else {
+            self.broad_phase.pairs.contains_key(&key)
         }
     }
 

@@ -48,7 +48,7 @@ impl World {
             for other in found {
                 // A pair that exists was in this step's narrow phase and solve, with a
                 // speculative margin for the motion the step began with.
-                if b.contact_keys.contains(&pair_key(sid.index, other)) {
+                if self.pair_exists(b, pair_key(sid.index, other)) {
                     continue;
                 }
                 let Some(o) = self.shapes.at(other) else { continue };
@@ -93,6 +93,5 @@ fn step_motion(b: &Body) -> Sweep {
 /// sweep's turn, from the straight line between its start and end positions: the sagitta
 /// of its arc, reach·(1 − cos(Δθ/2)) ≤ ½·reach·|q1 − q0| (the chord).
 fn sweep_bulge(sweep: &Sweep, reach: f32) -> f32 {
-    let chord = sweep.travel(reach) - (sweep.c1 - sweep.c0).length();
-    0.5 * chord
+    0.5 * sweep.chord(reach)
 }
