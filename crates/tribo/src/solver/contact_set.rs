@@ -130,6 +130,8 @@ struct Group {
 pub(crate) struct ContactSolver {
     /// Unit vector against gravity (zero without gravity).
     pub up: Vec2,
+    /// The contact softnesses of the step (the lanes pick theirs in the solve).
+    soft: StepSoftness,
     /// What the warm start reads of each group (parallel to `wide`).
     head: Vec<WideHead>,
     wide: Vec<WideContact>,
@@ -341,6 +343,7 @@ impl ContactSolver {
         self.cold.truncate(groups as usize);
         // 3. Slots: overflow constraints are built here, coloured ones below.
         let soft = StepSoftness::new(ctx);
+        self.soft = soft;
         self.slots.clear();
         self.lane_candidates.clear();
         self.lane_candidates.resize(groups as usize, [u32::MAX; LANES]);
@@ -395,7 +398,7 @@ impl ContactSolver {
                         .get(i as usize)
                         .map(|cand| (cand.contact, &cand.input, &cand.bodies))
                 });
-                contact_wide::build_group(h, w, cold, lanes, up, &soft, ctx, states);
+                contact_wide::build_group(h, w, cold, lanes, up, ctx, states);
             },
         );
         for (g, cold) in self.cold.iter().enumerate() {
@@ -470,7 +473,7 @@ impl ContactSolver {
         match slot {
             Slot::Wide { group, lane } => {
                 let g = group as usize;
-                contact_wide::unpack_full(&self.head[g], &self.wide[g], &self.cold[g], lane as usize)
+                contact_wide::unpack_full(&self.head[g], &self.wide[g], &self.cold[g], &self.soft, lane as usize)
             }
             Slot::Overflow(i) => self.overflow[i as usize],
         }
@@ -650,6 +653,7 @@ impl ConstraintSet for ContactSolver {
         for cc in &mut self.overflow {
             solve_one(cc, states, ctx, use_bias, elapsed);
         }
+        let soft = &self.soft;
         // Colour after colour; the groups of one colour share no moving body.
         for &(start, end) in &self.ranges {
             let (heads, colour) = (
@@ -658,11 +662,11 @@ impl ConstraintSet for ContactSolver {
             );
             if use_bias {
                 S::for_each_mut2(states, heads, colour, GROUP_CHUNK, |_, h, w, states| {
-                    contact_wide::solve::<true, S>(h, w, states, ctx, elapsed)
+                    contact_wide::solve::<true, S>(h, w, states, ctx, soft, elapsed)
                 });
             } else {
                 S::for_each_mut2(states, heads, colour, GROUP_CHUNK, |_, h, w, states| {
-                    contact_wide::solve::<false, S>(h, w, states, ctx, elapsed)
+                    contact_wide::solve::<false, S>(h, w, states, ctx, soft, elapsed)
                 });
             }
         }
@@ -733,7 +737,7 @@ impl ConstraintSet for ContactSolver {
                     )
                 });
                 if any {
-                    let mut cc = contact_wide::unpack_full(&self.head[g], &self.wide[g], &self.cold[g], l);
+                    let mut cc = contact_wide::unpack_full(&self.head[g], &self.wide[g], &self.cold[g], &self.soft, l);
                     restitution_one(&mut cc, states);
                     contact_wide::pack_state(&mut self.head[g], &mut self.wide[g], l, &cc);
                 }
@@ -754,6 +758,7 @@ impl ContactSolver {
     /// those run the per-colour path.
     fn team_loop(&mut self, ctx: &StepContext, sims: &[BodySim], states: &[SharedState], times: &mut [f32; 5]) -> bool {
         let threads = rayon::current_num_threads();
+        let soft = self.soft;
         if threads < 2 || !self.overflow.is_empty() || !self.groups.is_empty() || self.wide.is_empty() {
             return false;
         }
@@ -816,7 +821,7 @@ impl ContactSolver {
                 each_colour(k, &mut pass, &|h, _| contact_wide::warm_start(h, states));
                 t[1] += lap.lap();
                 each_colour(k, &mut pass, &|h, w| {
-                    contact_wide::solve::<true, SharedState>(h, w, states, ctx, elapsed)
+                    contact_wide::solve::<true, SharedState>(h, w, states, ctx, &soft, elapsed)
                 });
                 t[2] += lap.lap();
                 for b in bodies.clone() {
@@ -825,7 +830,7 @@ impl ContactSolver {
                 barrier.wait();
                 t[3] += lap.lap();
                 each_colour(k, &mut pass, &|h, w| {
-                    contact_wide::solve::<false, SharedState>(h, w, states, ctx, elapsed + ctx.h)
+                    contact_wide::solve::<false, SharedState>(h, w, states, ctx, &soft, elapsed + ctx.h)
                 });
                 t[4] += lap.lap();
             }

@@ -111,8 +111,8 @@ pub(crate) struct ContactConstraint {
     pub tangent_speed: f32,
     /// Normal-row matrix K of a 2-point manifold: [k11, k12, k22] [1/kg].
     pub k: [f32; 3],
-    /// Its inverse [k11, k12, k22] [kg].
-    pub inv_k: [f32; 3],
+    /// 1/det K [kg²]: K⁻¹ = [k22, −k12; −k12, k11] / det K.
+    pub inv_det: f32,
     /// The 2×2 block solver applies (two points, well conditioned).
     pub block: bool,
     /// Where impulses act between the two bodies' anchors as they move apart within a step:
@@ -260,7 +260,7 @@ pub(crate) fn build_constraint<S: StateRead>(
         rolling_impulse: if ctx.warm_starting { c.rolling_impulse } else { 0.0 },
         tangent_speed: c.tangent_speed,
         k: [0.0; 3],
-        inv_k: [0.0; 3],
+        inv_det: 0.0,
         block: false,
         patch_tangent_mass: 0.0,
         kinetic_energy: 0.0,
@@ -329,7 +329,7 @@ pub(crate) fn build_constraint<S: StateRead>(
         if k11 * k11 < 1000.0 * det && det > 0.0 {
             let inv = 1.0 / det;
             cc.k = [k11, k12, k22];
-            cc.inv_k = [k22 * inv, -k12 * inv, k11 * inv];
+            cc.inv_det = inv;
             cc.block = true;
         }
     }
@@ -358,7 +358,7 @@ pub(crate) fn fresh_point_sticks(
 }
 
 /// The two softness settings of a step's contacts.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct StepSoftness {
     /// Between two moving bodies.
     pub contact: Softness,
@@ -623,7 +623,7 @@ fn solve_block(cc: &ContactConstraint, rows: &[NormalRow; 2]) -> Option<[f32; 2]
     let pre = [p0.preload, p1.preload];
     let rhs = [rows[0].vn + rows[0].bias, rows[1].vn + rows[1].bias];
     let [k11, k12, k22] = cc.k;
-    let [i11, i12, i22] = cc.inv_k;
+    let (i11, i12, i22) = (k22 * cc.inv_det, -k12 * cc.inv_det, k11 * cc.inv_det);
     let soft = |i: usize, rigid_delta: f32| {
         lam[i] + rows[i].mass_scale * rigid_delta - rows[i].impulse_scale * (lam[i] - pre[i])
     };

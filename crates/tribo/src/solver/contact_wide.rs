@@ -31,7 +31,6 @@ use super::contact_solver::{
     ContactConstraint, ContactInput, StepSoftness,
 };
 use super::wide::{F4, LANES, M4, V4};
-use super::Softness;
 use super::{StateCell, StateRead, StepContext};
 use crate::collision::contact::{Contact, FrictionState, PointState};
 use crate::math::Vec2;
@@ -85,38 +84,33 @@ pub(crate) struct WideHead {
     pub points: [HeadPoint; 2],
     /// Friction impulse of the row (sum over the points) [N·s].
     pub tangent_impulse: F4,
-    /// Share of the row's friction impulse each point reports (½, ½ or 1, 0).
-    pub tangent_share: [F4; 2],
+    /// Lanes with a two-point manifold: the friction row sits at the patch middle and each
+    /// point reports half its impulse (one point: the whole).
+    pub two_points: M4,
     pub rolling_impulse: F4,
 }
 
 /// The rest of four contact constraints, one per lane (see the module docs): what only
 /// the solve passes read.
+///
+/// The passes are bound by memory traffic, so what costs a few instructions to derive is
+/// not stored: the softness (from whether a side is static), K⁻¹ (from K and 1/det K),
+/// 1/k11 and 1/k22 (the points' normal masses where the block applies), the friction row's
+/// anchors (from the points' anchors) and the rolling mass (from the inverse inertias).
+/// 400 bytes (was 608).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WideContact {
-    pub mu_s: F4,
-    pub mu_d: F4,
+    /// Friction coefficient of the row this step: μs where it sticks, μd where it slides.
+    pub mu: F4,
     pub tangent_speed: F4,
     pub rolling_resistance: F4,
-    pub rolling_mass: F4,
-    pub bias_rate: F4,
-    pub mass_scale: F4,
-    pub impulse_scale: F4,
     pub points: [WidePoint; 2],
-    /// Normal-row matrix K and its inverse (2-point manifolds with `block`).
+    /// Normal-row matrix K and 1/det K (2-point manifolds with `block`, else 0).
     pub k11: F4,
     pub k12: F4,
     pub k22: F4,
-    pub i11: F4,
-    pub i12: F4,
-    pub i22: F4,
-    /// 1/k11 and 1/k22 (0 where the block solve does not apply).
-    pub inv_k11: F4,
-    pub inv_k22: F4,
+    pub inv_det: F4,
     pub block: M4,
-    /// Friction row anchors (patch middle or the single point).
-    pub friction_r_a: V4,
-    pub friction_r_b: V4,
     pub tangent_mass: F4,
     pub base_drift: F4,
     pub stick: M4,
@@ -129,6 +123,8 @@ pub(crate) struct WideContact {
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WideCold {
     pub contact: [u32; LANES],
+    pub mu_s: [f32; LANES],
+    pub mu_d: [f32; LANES],
     /// Manifold points of each lane (0 for an empty lane).
     pub count: [u8; LANES],
     pub restitution: [f32; LANES],
@@ -141,6 +137,10 @@ pub(crate) struct WideCold {
     /// Some lane has restitution.
     pub any_restitution: bool,
 }
+
+// What the hot passes stream per group of four constraints (bytes).
+const _: () = assert!(core::mem::size_of::<WideContact>() == 400);
+const _: () = assert!(core::mem::size_of::<WideHead>() == 416);
 
 /// Four bodies' velocities and step motion, gathered from [`BodyState`]s.
 #[derive(Clone, Copy, Debug)]
@@ -232,6 +232,57 @@ fn anchor_displacement(a: &WideBody, b: &WideBody, d: V4, r_a: V4, r_b: V4) -> V
     d + (r_b.left_perp().scale(b.dq_s) - r_a.left_perp().scale(a.dq_s))
 }
 
+/// The friction row's anchors: the middle of a two-point patch, else the single point
+/// (`contact_solver::build_constraint`'s patch row; the same expression).
+#[inline(always)]
+fn friction_arms(h: &WideHead) -> (V4, V4) {
+    let [p0, p1] = &h.points;
+    let mid = |p: V4, q: V4| (p + q).scale(F4::splat(0.5));
+    let pick = |p: V4, q: V4| V4 {
+        x: h.two_points.select(p.x, q.x),
+        y: h.two_points.select(p.y, q.y),
+    };
+    (pick(mid(p0.r_a, p1.r_a), p0.r_a), pick(mid(p0.r_b, p1.r_b), p0.r_b))
+}
+
+/// The share of the row's friction impulse point `i` carries (½ each of two points, all of
+/// one; an empty lane's impulse is zero, whatever its share).
+#[inline(always)]
+fn tangent_share(h: &WideHead, i: usize) -> F4 {
+    let half = F4::splat(0.5);
+    if i == 0 {
+        h.two_points.select(half, F4::splat(1.0))
+    } else {
+        h.two_points.select(half, F4::ZERO)
+    }
+}
+
+/// Lanes with a static side (index 0): their contacts are twice as stiff (Box2D v3's
+/// static softness, `contact_solver::build_constraint`).
+#[inline(always)]
+fn static_lanes(h: &WideHead) -> M4 {
+    M4(core::array::from_fn(|l| {
+        if h.index_a[l] == 0 || h.index_b[l] == 0 {
+            u32::MAX
+        } else {
+            0
+        }
+    }))
+}
+
+/// The softness of each lane: (bias rate, mass scale, impulse scale).
+#[inline(always)]
+fn lane_softness(h: &WideHead, soft: &StepSoftness) -> (F4, F4, F4) {
+    let fixed = static_lanes(h);
+    let (s, c) = (&soft.static_contact, &soft.contact);
+    let pick = |x: f32, y: f32| fixed.select(F4::splat(x), F4::splat(y));
+    (
+        pick(s.bias_rate, c.bias_rate),
+        pick(s.mass_scale, c.mass_scale),
+        pick(s.impulse_scale, c.impulse_scale),
+    )
+}
+
 /// Re-applies the accumulated impulses at the start of a substep and records each point's
 /// normal velocity before them (restitution's impact speed).
 pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
@@ -248,7 +299,7 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
     }
     for (i, &(r_a, r_b)) in arms.iter().enumerate() {
         let p = &c.points[i];
-        let lt = c.tangent_impulse * c.tangent_share[i];
+        let lt = c.tangent_impulse * tangent_share(c, i);
         let imp = n.scale(p.normal_impulse) + t.scale(lt);
         apply(c, &mut a, &mut b, r_a, r_b, imp);
     }
@@ -267,6 +318,7 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     c: &mut WideContact,
     states: &[S],
     ctx: &StepContext,
+    soft: &StepSoftness,
     elapsed: f32,
 ) {
     let mut a = gather(states, &h.index_a);
@@ -277,6 +329,11 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     let zero = F4::ZERO;
     let one = F4::splat(1.0);
     let push = F4::splat(ctx.push_speed);
+    let (bias_rate, mass_scale, impulse_scale) = if USE_BIAS {
+        lane_softness(h, soft)
+    } else {
+        (zero, one, zero)
+    };
 
     // Normal rows: bias and softness per point (contact_solver::normal_row).
     let mut arms = [(V4::default(), V4::default()); 2];
@@ -290,7 +347,7 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
         let s = anchor_displacement(&a, &b, d, hp.r_a, hp.r_b).dot(n) + p.base_separation;
         let speculative = s.gt(zero);
         let (soft_bias, soft_ms, soft_is) = if USE_BIAS {
-            ((c.bias_rate * s).max(-push), c.mass_scale, c.impulse_scale)
+            ((bias_rate * s).max(-push), mass_scale, impulse_scale)
         } else {
             (zero, one, zero)
         };
@@ -307,8 +364,10 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     let rhs1 = vn[1] + bias[1];
     let soft0 = |rd: F4| lam0 + ms[0] * rd - is[0] * (lam0 - pre0);
     let soft1 = |rd: F4| lam1 + ms[1] * rd - is[1] * (lam1 - pre1);
-    let xa0 = soft0(-(c.i11 * rhs0 + c.i12 * rhs1));
-    let xa1 = soft1(-(c.i12 * rhs0 + c.i22 * rhs1));
+    // K⁻¹ = [k22, −k12; −k12, k11] / det K (zero where the block does not apply).
+    let (i11, i12, i22) = (c.k22 * c.inv_det, -c.k12 * c.inv_det, c.k11 * c.inv_det);
+    let xa0 = soft0(-(i11 * rhs0 + i12 * rhs1));
+    let xa1 = soft1(-(i12 * rhs0 + i22 * rhs1));
     let ok_a = xa0.ge(zero) & xa1.ge(zero);
     let (new0, new1) = if (ok_a & c.block).all() {
         // Common case (a resting face): both points active in every lane.
@@ -317,11 +376,12 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
         (xa0, xa1)
     } else {
         let r0 = rhs0 - c.k12 * lam1;
-        let xb0 = soft0(-(r0 * c.inv_k11));
+        // 1/k11 and 1/k22: the points' normal masses (where the block applies).
+        let xb0 = soft0(-(r0 * p0.normal_mass));
         let wb1 = rhs1 + c.k12 * (xb0 - lam0) - c.k22 * lam1;
         let ok_b = xb0.ge(zero) & wb1.ge(zero);
         let r1 = rhs1 - c.k12 * lam0;
-        let xc1 = soft1(-(r1 * c.inv_k22));
+        let xc1 = soft1(-(r1 * p1.normal_mass));
         let wc0 = rhs0 + c.k12 * (xc1 - lam1) - c.k11 * lam0;
         let ok_c = xc1.ge(zero) & wc0.ge(zero);
         let wd0 = rhs0 - c.k11 * lam0 - c.k12 * lam1;
@@ -359,14 +419,14 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
 
     // Friction row (contact_solver::solve_friction).
     let t = V4 { x: n.y, y: -n.x };
-    let (r_a, r_b) = lever_arms(h, shift, c.friction_r_a, c.friction_r_b);
-    let mu = c.stick.select(c.mu_s, c.mu_d);
-    let limit = mu * (new0 + new1);
+    let (fr_a, fr_b) = friction_arms(h);
+    let (r_a, r_b) = lever_arms(h, shift, fr_a, fr_b);
+    let limit = c.mu * (new0 + new1);
     let vt = relative_velocity(&a, &b, r_a, r_b).dot(t) - c.tangent_speed;
     let fbias = if USE_BIAS {
-        let drift = anchor_displacement(&a, &b, d, c.friction_r_a, c.friction_r_b).dot(t) + c.base_drift
-            - c.tangent_speed * F4::splat(elapsed);
-        let rate = c.bias_rate * drift;
+        let drift =
+            anchor_displacement(&a, &b, d, fr_a, fr_b).dot(t) + c.base_drift - c.tangent_speed * F4::splat(elapsed);
+        let rate = bias_rate * drift;
         (c.stick & limit.gt(zero)).select(rate.clamp(-push, push), zero)
     } else {
         zero
@@ -384,7 +444,9 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
         c.saturated = limit.gt(zero) & unclamped.abs().gt(limit);
         if h.any_rolling {
             let rlimit = c.rolling_resistance * (new0 + new1);
-            let imp = -(c.rolling_mass * (b.w - a.w));
+            let k_roll = h.inv_i_a + h.inv_i_b;
+            let rolling_mass = k_roll.gt(zero).select(one / k_roll, zero);
+            let imp = -(rolling_mass * (b.w - a.w));
             let rnew = (h.rolling_impulse + imp).clamp(-rlimit, rlimit);
             let delta = rnew - h.rolling_impulse;
             h.rolling_impulse = rnew;
@@ -411,7 +473,6 @@ pub(crate) fn build_group<S: StateRead>(
     cold: &mut WideCold,
     lanes: [LaneInput<'_>; LANES],
     up: Vec2,
-    soft: &StepSoftness,
     ctx: &StepContext,
     states: &[S],
 ) {
@@ -455,22 +516,13 @@ pub(crate) fn build_group<S: StateRead>(
         center_a.y.0[l] = b.center_a.y;
         center_b.x.0[l] = b.center_b.x;
         center_b.y.0[l] = b.center_b.y;
-        out.mu_s.0[l] = input.mu_s;
-        out.mu_d.0[l] = input.mu_d;
+        c.mu_s[l] = input.mu_s;
+        c.mu_d[l] = input.mu_d;
         out.tangent_speed.0[l] = input.tangent_speed;
         out.rolling_resistance.0[l] = input.rolling_resistance;
         let rolling_impulse = if warm { input.rolling_impulse } else { 0.0 };
         hd.rolling_impulse.0[l] = rolling_impulse;
         hd.any_rolling |= input.rolling_resistance > 0.0 || rolling_impulse != 0.0;
-        // Contacts with static bodies are twice as stiff (Box2D v3's static softness).
-        let ps = if b.index_a == 0 || b.index_b == 0 {
-            soft.static_contact
-        } else {
-            soft.contact
-        };
-        out.bias_rate.0[l] = ps.bias_rate;
-        out.mass_scale.0[l] = ps.mass_scale;
-        out.impulse_scale.0[l] = ps.impulse_scale;
         let states_ab = input.points[..count]
             .iter()
             .any(|p| p.fresh)
@@ -508,12 +560,7 @@ pub(crate) fn build_group<S: StateRead>(
         // Summed as `pack_state` sums (the same sign of a zero sum).
         tangent_sum.0[l] = ts[..count].iter().sum();
         out.stick.0[l] = if row_stick { u32::MAX } else { 0 };
-        hd.tangent_share[0].0[l] = match count {
-            2 => 0.5,
-            1 => 1.0,
-            _ => 0.0,
-        };
-        hd.tangent_share[1].0[l] = if count == 2 { 0.5 } else { 0.0 };
+        out.mu.0[l] = if row_stick { input.mu_s } else { input.mu_d };
     }
     hd.tangent_impulse = tangent_sum;
     // Four lanes at once (contact_solver::build_constraint and pack).
@@ -529,8 +576,6 @@ pub(crate) fn build_group<S: StateRead>(
     let sum = ma + mb;
     hd.split = sum.gt(zero).select(mb / sum, half);
     hd.shift_cap2 = F4(core::array::from_fn(|l| shift_cap2(ma.0[l], ia.0[l], mb.0[l], ib.0[l])));
-    let k_roll = ia + ib;
-    out.rolling_mass = inv_or_zero(k_roll);
     let mut arms = [(V4::default(), V4::default()); 2];
     let mut kn = [zero; 2];
     for i in 0..2 {
@@ -548,15 +593,10 @@ pub(crate) fn build_group<S: StateRead>(
     }
     let ((ra0, rb0), (ra1, rb1)) = (arms[0], arms[1]);
     let two = has[1];
+    hd.two_points = two;
     // Friction row: the patch middle of two points, or the single point.
-    let mid = |p: V4, q: V4| (p + q).scale(half);
-    let pick = |m: M4, p: V4, q: V4| V4 {
-        x: m.select(p.x, q.x),
-        y: m.select(p.y, q.y),
-    };
-    out.friction_r_a = pick(two, mid(ra0, ra1), ra0);
-    out.friction_r_b = pick(two, mid(rb0, rb1), rb0);
-    out.tangent_mass = has[0].select(inv_or_zero(k_of(out.friction_r_a, out.friction_r_b, t)), zero);
+    let (fr_a, fr_b) = friction_arms(hd);
+    out.tangent_mass = has[0].select(inv_or_zero(k_of(fr_a, fr_b, t)), zero);
     let d0 = F4(c.base_drift[0]);
     let d1 = F4(c.base_drift[1]);
     out.base_drift = two.select(half * (d0 + d1), d0);
@@ -572,11 +612,7 @@ pub(crate) fn build_group<S: StateRead>(
     out.k11 = block.select(k11, zero);
     out.k12 = block.select(k12, zero);
     out.k22 = block.select(k22, zero);
-    out.i11 = block.select(k22 * inv, zero);
-    out.i12 = block.select(-k12 * inv, zero);
-    out.i22 = block.select(k11 * inv, zero);
-    out.inv_k11 = block.select(one / k11, zero);
-    out.inv_k22 = block.select(one / k22, zero);
+    out.inv_det = block.select(inv, zero);
 }
 
 /// What the store writes into one contact: its points' persistent states and the rolling
@@ -638,7 +674,7 @@ pub(crate) fn store_group<S: StateRead>(
             sum_t += tangent;
             sum_n += p.normal_impulse.0[l];
         }
-        let patch_saturated = sum_t.abs() >= 0.999 * w.mu_s.0[l] * sum_n && count > 0 && saturated;
+        let patch_saturated = sum_t.abs() >= 0.999 * cold.mu_s[l] * sum_n && count > 0 && saturated;
         let sum_total_t: f32 = (0..count).map(|_| total_tangent).sum();
         let sum_total_n: f32 = w.points[..count].iter().map(|p| p.total_normal_impulse.0[l]).sum();
         let tangent_speed = w.tangent_speed.0[l];
@@ -735,16 +771,11 @@ pub(crate) fn pack(
     h.inv_i_b.0[l] = cc.inv_i_b;
     h.split.0[l] = cc.split;
     h.shift_cap2.0[l] = cc.shift_cap2;
-    w.mu_s.0[l] = cc.mu_s;
-    w.mu_d.0[l] = cc.mu_d;
+    cold.mu_s[l] = cc.mu_s;
+    cold.mu_d[l] = cc.mu_d;
     w.tangent_speed.0[l] = cc.tangent_speed;
     w.rolling_resistance.0[l] = cc.rolling_resistance;
-    w.rolling_mass.0[l] = cc.rolling_mass;
     h.any_rolling |= cc.rolling_resistance > 0.0 || cc.rolling_impulse != 0.0;
-    let soft = cc.points[0].soft;
-    w.bias_rate.0[l] = soft.bias_rate;
-    w.mass_scale.0[l] = soft.mass_scale;
-    w.impulse_scale.0[l] = soft.impulse_scale;
     for i in 0..2 {
         let (hp, wp) = (&mut h.points[i], &mut w.points[i]);
         if i < cc.count {
@@ -774,38 +805,27 @@ pub(crate) fn pack(
     }
     let block = cc.count == 2 && cc.block;
     let k = if block { cc.k } else { [0.0; 3] };
-    let ik = if block { cc.inv_k } else { [0.0; 3] };
     w.k11.0[l] = k[0];
     w.k12.0[l] = k[1];
     w.k22.0[l] = k[2];
-    w.i11.0[l] = ik[0];
-    w.i12.0[l] = ik[1];
-    w.i22.0[l] = ik[2];
-    w.inv_k11.0[l] = if block { 1.0 / k[0] } else { 0.0 };
-    w.inv_k22.0[l] = if block { 1.0 / k[2] } else { 0.0 };
+    w.inv_det.0[l] = if block { cc.inv_det } else { 0.0 };
     w.block.0[l] = if block { u32::MAX } else { 0 };
     let (p0, p1) = (&cc.points[0], &cc.points[1]);
-    let (fr_a, fr_b, tm, drift, stick, share) = match cc.count {
+    // The friction row's anchors follow from the points' (`friction_arms`).
+    let (tm, drift, stick) = match cc.count {
         2 => (
-            0.5 * (p0.r_a + p1.r_a),
-            0.5 * (p0.r_b + p1.r_b),
             cc.patch_tangent_mass,
             0.5 * (p0.base_drift + p1.base_drift),
             p0.stick && p1.stick,
-            [0.5, 0.5],
         ),
-        1 => (p0.r_a, p0.r_b, p0.tangent_mass, p0.base_drift, p0.stick, [1.0, 0.0]),
-        _ => (Vec2::ZERO, Vec2::ZERO, 0.0, 0.0, true, [0.0, 0.0]),
+        1 => (p0.tangent_mass, p0.base_drift, p0.stick),
+        _ => (0.0, 0.0, true),
     };
-    w.friction_r_a.x.0[l] = fr_a.x;
-    w.friction_r_a.y.0[l] = fr_a.y;
-    w.friction_r_b.x.0[l] = fr_b.x;
-    w.friction_r_b.y.0[l] = fr_b.y;
     w.tangent_mass.0[l] = tm;
     w.base_drift.0[l] = drift;
     w.stick.0[l] = if stick { u32::MAX } else { 0 };
-    h.tangent_share[0].0[l] = share[0];
-    h.tangent_share[1].0[l] = share[1];
+    w.mu.0[l] = if stick { cc.mu_s } else { cc.mu_d };
+    h.two_points.0[l] = if cc.count == 2 { u32::MAX } else { 0 };
     pack_state(h, w, l, cc);
 }
 
@@ -861,14 +881,21 @@ pub(crate) fn unpack_state(h: &WideHead, w: &WideContact, l: usize, cc: &mut Con
 }
 
 /// Rebuilds the scalar constraint of lane `l` (geometry, masses and current state).
-pub(crate) fn unpack_full(h: &WideHead, w: &WideContact, cold: &WideCold, l: usize) -> ContactConstraint {
+pub(crate) fn unpack_full(
+    h: &WideHead,
+    w: &WideContact,
+    cold: &WideCold,
+    soft: &StepSoftness,
+    l: usize,
+) -> ContactConstraint {
     let count = cold.count[l] as usize;
     let block = w.block.lane(l);
-    let soft = Softness {
-        bias_rate: w.bias_rate.0[l],
-        mass_scale: w.mass_scale.0[l],
-        impulse_scale: w.impulse_scale.0[l],
+    let soft = if h.index_a[l] == 0 || h.index_b[l] == 0 {
+        soft.static_contact
+    } else {
+        soft.contact
     };
+    let k_roll = h.inv_i_a.0[l] + h.inv_i_b.0[l];
     let mut cc = ContactConstraint {
         index_a: h.index_a[l],
         index_b: h.index_b[l],
@@ -878,12 +905,12 @@ pub(crate) fn unpack_full(h: &WideHead, w: &WideContact, cold: &WideCold, l: usi
         inv_i_a: h.inv_i_a.0[l],
         inv_mass_b: h.inv_mass_b.0[l],
         inv_i_b: h.inv_i_b.0[l],
-        mu_s: w.mu_s.0[l],
-        mu_d: w.mu_d.0[l],
+        mu_s: cold.mu_s[l],
+        mu_d: cold.mu_d[l],
         restitution: cold.restitution[l],
         restitution_threshold: cold.restitution_threshold[l],
         rolling_resistance: w.rolling_resistance.0[l],
-        rolling_mass: w.rolling_mass.0[l],
+        rolling_mass: if k_roll > 0.0 { 1.0 / k_roll } else { 0.0 },
         rolling_impulse: 0.0,
         tangent_speed: w.tangent_speed.0[l],
         k: if block {
@@ -891,11 +918,7 @@ pub(crate) fn unpack_full(h: &WideHead, w: &WideContact, cold: &WideCold, l: usi
         } else {
             [0.0; 3]
         },
-        inv_k: if block {
-            [w.i11.0[l], w.i12.0[l], w.i22.0[l]]
-        } else {
-            [0.0; 3]
-        },
+        inv_det: if block { w.inv_det.0[l] } else { 0.0 },
         block,
         split: h.split.0[l],
         shift_cap2: h.shift_cap2.0[l],
@@ -1034,7 +1057,7 @@ mod tests {
         let f = fixture();
         let (ctx, soft, states, up, cases) = (f.ctx, f.soft, &f.states, f.up, &f.cases);
         let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
-        build_group(&mut h, &mut w, &mut cold, f.lanes(), up, &soft, &ctx, states);
+        build_group(&mut h, &mut w, &mut cold, f.lanes(), up, &ctx, states);
         let (mut rh, mut r, mut rcold) = (h, w, cold);
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
             let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
@@ -1052,6 +1075,17 @@ mod tests {
         assert_eq!(format!("{h:?}"), format!("{rh:?}"));
         assert_eq!(format!("{w:?}"), format!("{r:?}"));
         assert_eq!(format!("{cold:?}"), format!("{rcold:?}"));
+        // What the lanes derive instead of storing (softness, K⁻¹, rolling mass, friction
+        // coefficient) comes back as the scalar build made it.
+        for (l, (ci, inp, b)) in cases.iter().enumerate() {
+            let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
+            let u = unpack_full(&h, &w, &cold, &soft, l);
+            let derived = |c: &ContactConstraint| {
+                let soft: Vec<_> = c.points[..c.count].iter().map(|p| p.soft).collect();
+                format!("{:?}", (c.mu_s, c.mu_d, c.rolling_mass, c.k, c.inv_det, c.block, soft))
+            };
+            assert_eq!(derived(&u), derived(&cc), "lane {l}");
+        }
         // The cases do what they claim: a carried point sticks, a new one in contact and
         // slipping slides; the empty lane carries no mass.
         assert!(cold.stick[0][0] && !cold.stick[0][1] && cold.fresh[0][1]);
@@ -1071,9 +1105,9 @@ mod tests {
     fn wide_store_equals_scalar_store() {
         let f = fixture();
         let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
-        build_group(&mut h, &mut w, &mut cold, f.lanes(), f.up, &f.soft, &f.ctx, &f.states);
+        build_group(&mut h, &mut w, &mut cold, f.lanes(), f.up, &f.ctx, &f.states);
         let cells: Vec<core::cell::Cell<BodyState>> = f.states.iter().map(|&s| core::cell::Cell::new(s)).collect();
-        solve::<false, _>(&mut h, &mut w, &cells, &f.ctx, f.ctx.h);
+        solve::<false, _>(&mut h, &mut w, &cells, &f.ctx, &f.soft, f.ctx.h);
         let moved: Vec<BodyState> = cells
             .iter()
             .map(|c| {
@@ -1087,7 +1121,7 @@ mod tests {
         store_group(&h, &w, &cold, &moved, &f.ctx, &mut out);
         let (mut slipped, mut pushed) = (false, false);
         for l in 0..3 {
-            let cc = unpack_full(&h, &w, &cold, l);
+            let cc = unpack_full(&h, &w, &cold, &f.soft, l);
             let mut c = crate::collision::contact::blank_contact();
             store_impulses(&cc, &mut c, &moved, &f.ctx);
             let n = cc.count;

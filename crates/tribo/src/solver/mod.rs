@@ -47,8 +47,8 @@ pub(crate) struct BodyState {
 }
 
 /// A body's [`BodyState`] shared by the worker threads of a step: plain memory, read and
-/// written without atomics (one of the crate's two `unsafe` sites; the other is
-/// [`prefetch`]).
+/// written without atomics (one of the crate's three `unsafe` sites; the others are
+/// [`prefetch`] and the SSE intrinsics of [`wide`]).
 ///
 /// Why it is race-free — the contract every user of [`StateCell`] for `SharedState` keeps:
 /// - a constraint pass runs colour by colour, and the constraints of one colour share no

@@ -2,9 +2,13 @@
 //!
 //! `F4` is four `f32` lanes; every operation is lane-wise plain IEEE arithmetic (no fused
 //! multiply-add, no approximate reciprocal), so a lane computes bit for bit what the same
-//! scalar expression computes. The lane loops are written so that LLVM turns them into
-//! single SSE2 / NEON instructions (the crate forbids `unsafe`, so no intrinsics); masks
-//! are lanes of all-ones / all-zeros bits, like SIMD compare results.
+//! scalar expression computes. On x86-64 every operation is one SSE instruction (safe
+//! intrinsics of the baseline target; the lanes move in and out of registers with
+//! `setr`/shuffles, which LLVM turns into plain vector loads and stores). Elsewhere the
+//! lane loops are left to LLVM's vectorizer, which on x86-64 turned the selects of
+//! compare results back into per-lane branches (Box2D's SIMD solver writes intrinsics for
+//! the same reason). Masks are lanes of all-ones / all-zeros bits, like SIMD compare
+//! results.
 
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub, SubAssign};
 
@@ -21,6 +25,120 @@ pub(crate) struct F4(pub [f32; LANES]);
 #[repr(C, align(16))]
 pub(crate) struct M4(pub [u32; LANES]);
 
+/// The SSE forms of the lane operations: x86-64's baseline SSE/SSE2 intrinsics, wrapped as
+/// safe functions (the crate's third `unsafe` site).
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod sse {
+    use super::{F4, M4};
+    pub use core::arch::x86_64::{__m128, __m128i};
+
+    /// Wraps intrinsics of the x86-64 baseline as safe functions.
+    macro_rules! baseline {
+        ($($name:ident($($a:ident: $t:ty),*) -> $r:ty;)*) => {$(
+            #[inline(always)]
+            pub fn $name($($a: $t),*) -> $r {
+                // SAFETY: SSE and SSE2 are part of every x86-64 CPU (the target's baseline
+                // features, always enabled); these intrinsics work on values only: they
+                // read and write no memory.
+                unsafe { core::arch::x86_64::$name($($a),*) }
+            }
+        )*};
+    }
+
+    baseline! {
+        _mm_setr_ps(a: f32, b: f32, c: f32, d: f32) -> __m128;
+        _mm_set1_ps(a: f32) -> __m128;
+        _mm_setr_epi32(a: i32, b: i32, c: i32, d: i32) -> __m128i;
+        _mm_set1_epi32(a: i32) -> __m128i;
+        _mm_castsi128_ps(a: __m128i) -> __m128;
+        _mm_castps_si128(a: __m128) -> __m128i;
+        _mm_cvtss_f32(a: __m128) -> f32;
+        _mm_cvtsi128_si32(a: __m128i) -> i32;
+        _mm_add_ps(a: __m128, b: __m128) -> __m128;
+        _mm_sub_ps(a: __m128, b: __m128) -> __m128;
+        _mm_mul_ps(a: __m128, b: __m128) -> __m128;
+        _mm_div_ps(a: __m128, b: __m128) -> __m128;
+        _mm_sqrt_ps(a: __m128) -> __m128;
+        _mm_max_ps(a: __m128, b: __m128) -> __m128;
+        _mm_min_ps(a: __m128, b: __m128) -> __m128;
+        _mm_and_ps(a: __m128, b: __m128) -> __m128;
+        _mm_andnot_ps(a: __m128, b: __m128) -> __m128;
+        _mm_or_ps(a: __m128, b: __m128) -> __m128;
+        _mm_xor_ps(a: __m128, b: __m128) -> __m128;
+        _mm_cmpgt_ps(a: __m128, b: __m128) -> __m128;
+        _mm_cmpge_ps(a: __m128, b: __m128) -> __m128;
+        _mm_cmplt_ps(a: __m128, b: __m128) -> __m128;
+        _mm_movemask_ps(a: __m128) -> i32;
+    }
+
+    /// Lane `L` of `v` moved to lane 0.
+    #[inline(always)]
+    fn lane<const L: i32>(v: __m128) -> __m128 {
+        // SAFETY: as `baseline!`.
+        unsafe { core::arch::x86_64::_mm_shuffle_ps::<L>(v, v) }
+    }
+
+    #[inline(always)]
+    fn lane_i<const L: i32>(v: __m128i) -> __m128i {
+        // SAFETY: as `baseline!`.
+        unsafe { core::arch::x86_64::_mm_shuffle_epi32::<L>(v) }
+    }
+
+    #[inline(always)]
+    pub fn f(x: F4) -> __m128 {
+        _mm_setr_ps(x.0[0], x.0[1], x.0[2], x.0[3])
+    }
+
+    #[inline(always)]
+    pub fn m(x: M4) -> __m128 {
+        _mm_castsi128_ps(_mm_setr_epi32(
+            x.0[0] as i32,
+            x.0[1] as i32,
+            x.0[2] as i32,
+            x.0[3] as i32,
+        ))
+    }
+
+    #[inline(always)]
+    pub fn to_f(v: __m128) -> F4 {
+        F4([
+            _mm_cvtss_f32(v),
+            _mm_cvtss_f32(lane::<0b01_01_01_01>(v)),
+            _mm_cvtss_f32(lane::<0b10_10_10_10>(v)),
+            _mm_cvtss_f32(lane::<0b11_11_11_11>(v)),
+        ])
+    }
+
+    #[inline(always)]
+    pub fn to_m(v: __m128) -> M4 {
+        let i = _mm_castps_si128(v);
+        M4([
+            _mm_cvtsi128_si32(i) as u32,
+            _mm_cvtsi128_si32(lane_i::<0b01_01_01_01>(i)) as u32,
+            _mm_cvtsi128_si32(lane_i::<0b10_10_10_10>(i)) as u32,
+            _mm_cvtsi128_si32(lane_i::<0b11_11_11_11>(i)) as u32,
+        ])
+    }
+}
+
+/// `$sse` (an expression over `core::arch::x86_64` and [`sse`]) on x86-64, else `$lanes`.
+macro_rules! simd {
+    ($sse:expr, $lanes:expr) => {{
+        #[cfg(target_arch = "x86_64")]
+        {
+            #[allow(unused_imports)]
+            use sse::*;
+            $sse
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            $lanes
+        }
+    }};
+}
+
+#[cfg_attr(target_arch = "x86_64", allow(unused_macros))]
 macro_rules! lanes {
     (|$i:ident| $e:expr) => {{
         let mut out = [Default::default(); LANES];
@@ -44,13 +162,19 @@ impl F4 {
     /// Lane-wise maximum (`a > b ? a : b`, like SSE `maxps` with the operands swapped).
     #[inline(always)]
     pub fn max(self, o: F4) -> F4 {
-        F4(lanes!(|i| if self.0[i] > o.0[i] { self.0[i] } else { o.0[i] }))
+        simd!(
+            sse::to_f(_mm_max_ps(sse::f(self), sse::f(o))),
+            F4(lanes!(|i| if self.0[i] > o.0[i] { self.0[i] } else { o.0[i] }))
+        )
     }
 
     /// Lane-wise minimum.
     #[inline(always)]
     pub fn min(self, o: F4) -> F4 {
-        F4(lanes!(|i| if self.0[i] < o.0[i] { self.0[i] } else { o.0[i] }))
+        simd!(
+            sse::to_f(_mm_min_ps(sse::f(self), sse::f(o))),
+            F4(lanes!(|i| if self.0[i] < o.0[i] { self.0[i] } else { o.0[i] }))
+        )
     }
 
     #[inline(always)]
@@ -61,31 +185,44 @@ impl F4 {
     /// Lane-wise square root (IEEE, as `f32::sqrt`).
     #[inline(always)]
     pub fn sqrt(self) -> F4 {
-        F4(lanes!(|i| self.0[i].sqrt()))
+        simd!(sse::to_f(_mm_sqrt_ps(sse::f(self))), F4(lanes!(|i| self.0[i].sqrt())))
     }
 
     #[inline(always)]
     pub fn abs(self) -> F4 {
-        F4(lanes!(|i| f32::from_bits(self.0[i].to_bits() & 0x7fff_ffff)))
+        simd!(
+            sse::to_f(_mm_and_ps(sse::f(self), _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff)))),
+            F4(lanes!(|i| f32::from_bits(self.0[i].to_bits() & 0x7fff_ffff)))
+        )
     }
 
     #[inline(always)]
     pub fn gt(self, o: F4) -> M4 {
-        M4(lanes!(|i| mask(self.0[i] > o.0[i])))
+        simd!(
+            sse::to_m(_mm_cmpgt_ps(sse::f(self), sse::f(o))),
+            M4(lanes!(|i| mask(self.0[i] > o.0[i])))
+        )
     }
 
     #[inline(always)]
     pub fn ge(self, o: F4) -> M4 {
-        M4(lanes!(|i| mask(self.0[i] >= o.0[i])))
+        simd!(
+            sse::to_m(_mm_cmpge_ps(sse::f(self), sse::f(o))),
+            M4(lanes!(|i| mask(self.0[i] >= o.0[i])))
+        )
     }
 
     #[inline(always)]
     pub fn lt(self, o: F4) -> M4 {
-        M4(lanes!(|i| mask(self.0[i] < o.0[i])))
+        simd!(
+            sse::to_m(_mm_cmplt_ps(sse::f(self), sse::f(o))),
+            M4(lanes!(|i| mask(self.0[i] < o.0[i])))
+        )
     }
 }
 
 #[inline(always)]
+#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
 fn mask(b: bool) -> u32 {
     if b {
         u32::MAX
@@ -103,45 +240,60 @@ impl M4 {
     /// Whether some lane is true.
     #[inline(always)]
     pub fn any(self) -> bool {
-        (self.0[0] | self.0[1] | self.0[2] | self.0[3]) != 0
+        simd!(
+            _mm_movemask_ps(sse::m(self)) != 0,
+            (self.0[0] | self.0[1] | self.0[2] | self.0[3]) != 0
+        )
     }
 
     /// Whether every lane is true.
     #[inline(always)]
     pub fn all(self) -> bool {
-        (self.0[0] & self.0[1] & self.0[2] & self.0[3]) == u32::MAX
+        simd!(
+            _mm_movemask_ps(sse::m(self)) == 0b1111,
+            (self.0[0] & self.0[1] & self.0[2] & self.0[3]) == u32::MAX
+        )
     }
 
     /// `self ? a : b` lane by lane.
     #[inline(always)]
     pub fn select(self, a: F4, b: F4) -> F4 {
-        F4(lanes!(|i| f32::from_bits(
-            (a.0[i].to_bits() & self.0[i]) | (b.0[i].to_bits() & !self.0[i])
-        )))
+        simd!(
+            {
+                let m = sse::m(self);
+                sse::to_f(_mm_or_ps(_mm_and_ps(m, sse::f(a)), _mm_andnot_ps(m, sse::f(b))))
+            },
+            F4(lanes!(|i| f32::from_bits(
+                (a.0[i].to_bits() & self.0[i]) | (b.0[i].to_bits() & !self.0[i])
+            )))
+        )
     }
 
     /// 1.0 where true, 0.0 where false.
     #[inline(always)]
     pub fn to_unit(self) -> F4 {
-        F4(lanes!(|i| f32::from_bits(1.0f32.to_bits() & self.0[i])))
+        simd!(
+            sse::to_f(_mm_and_ps(sse::m(self), _mm_set1_ps(1.0))),
+            F4(lanes!(|i| f32::from_bits(1.0f32.to_bits() & self.0[i])))
+        )
     }
 }
 
 macro_rules! f4_binop {
-    ($tr:ident, $f:ident, $op:tt) => {
+    ($tr:ident, $f:ident, $op:tt, $sse:ident) => {
         impl $tr for F4 {
             type Output = F4;
             #[inline(always)]
             fn $f(self, o: F4) -> F4 {
-                F4(lanes!(|i| self.0[i] $op o.0[i]))
+                simd!(sse::to_f($sse(sse::f(self), sse::f(o))), F4(lanes!(|i| self.0[i] $op o.0[i])))
             }
         }
     };
 }
-f4_binop!(Add, add, +);
-f4_binop!(Sub, sub, -);
-f4_binop!(Mul, mul, *);
-f4_binop!(Div, div, /);
+f4_binop!(Add, add, +, _mm_add_ps);
+f4_binop!(Sub, sub, -, _mm_sub_ps);
+f4_binop!(Mul, mul, *, _mm_mul_ps);
+f4_binop!(Div, div, /, _mm_div_ps);
 
 impl Mul<F4> for f32 {
     type Output = F4;
@@ -155,7 +307,10 @@ impl Neg for F4 {
     type Output = F4;
     #[inline(always)]
     fn neg(self) -> F4 {
-        F4(lanes!(|i| -self.0[i]))
+        simd!(
+            sse::to_f(_mm_xor_ps(sse::f(self), _mm_set1_ps(-0.0))),
+            F4(lanes!(|i| -self.0[i]))
+        )
     }
 }
 
@@ -177,7 +332,10 @@ impl BitAnd for M4 {
     type Output = M4;
     #[inline(always)]
     fn bitand(self, o: M4) -> M4 {
-        M4(lanes!(|i| self.0[i] & o.0[i]))
+        simd!(
+            sse::to_m(_mm_and_ps(sse::m(self), sse::m(o))),
+            M4(lanes!(|i| self.0[i] & o.0[i]))
+        )
     }
 }
 
@@ -185,7 +343,10 @@ impl BitOr for M4 {
     type Output = M4;
     #[inline(always)]
     fn bitor(self, o: M4) -> M4 {
-        M4(lanes!(|i| self.0[i] | o.0[i]))
+        simd!(
+            sse::to_m(_mm_or_ps(sse::m(self), sse::m(o))),
+            M4(lanes!(|i| self.0[i] | o.0[i]))
+        )
     }
 }
 
@@ -193,7 +354,10 @@ impl Not for M4 {
     type Output = M4;
     #[inline(always)]
     fn not(self) -> M4 {
-        M4(lanes!(|i| !self.0[i]))
+        simd!(
+            sse::to_m(_mm_xor_ps(sse::m(self), _mm_castsi128_ps(_mm_set1_epi32(-1)))),
+            M4(lanes!(|i| !self.0[i]))
+        )
     }
 }
 
