@@ -27,8 +27,8 @@
 //! operations, so a contact solved wide or scalar gets the same numbers.
 
 use super::contact_solver::{
-    bounces, fresh_point_sticks, kinetic_energy_of, next_preload, shift_cap2, ConstraintBodies, ConstraintPoint,
-    ContactConstraint, ContactInput, StepSoftness,
+    fresh_point_sticks, kinetic_energy_of, shift_cap2, ConstraintBodies, ConstraintPoint, ContactConstraint,
+    ContactInput, StepSoftness,
 };
 use super::wide::{F4, LANES, M4, V4};
 use super::{StateCell, StateRead, StepContext};
@@ -630,8 +630,13 @@ impl StoredContact {
     /// impulse).
     #[inline]
     pub(crate) fn write_into(&self, c: &mut Contact) {
-        let n = (self.count as usize).min(self.points.len());
-        c.points[..n].copy_from_slice(&self.points[..n]);
+        // Fixed-size copies (a slice copy of variable length is a `memcpy` call).
+        if self.count >= 1 {
+            c.points[0] = self.points[0];
+        }
+        if self.count >= 2 {
+            c.points[1] = self.points[1];
+        }
         c.rolling_impulse = self.rolling_impulse;
     }
 }
@@ -662,77 +667,75 @@ pub(crate) fn store_group<S: StateRead>(
         vt[i] = relative_velocity(&a, &b, r_a, r_b).dot(t) - w.tangent_speed;
         disp[i] = anchor_displacement(&a, &b, d, p.r_a, p.r_b).dot(t);
     }
-    for (l, o) in out.iter_mut().enumerate() {
-        let count = (cold.count[l] as usize).min(2);
-        o.count = count as u8;
-        o.rolling_impulse = h.rolling_impulse.0[l];
-        let share = if count == 2 { 0.5 } else { 1.0 };
-        let saturated = w.saturated.lane(l);
-        let (tangent, total_tangent) = (share * h.tangent_impulse.0[l], share * w.total_tangent_impulse.0[l]);
-        let (mut sum_t, mut sum_n) = (0.0f32, 0.0f32);
-        for p in &h.points[..count] {
-            sum_t += tangent;
-            sum_n += p.normal_impulse.0[l];
-        }
-        let patch_saturated = sum_t.abs() >= 0.999 * cold.mu_s[l] * sum_n && count > 0 && saturated;
-        let sum_total_t: f32 = (0..count).map(|_| total_tangent).sum();
-        let sum_total_n: f32 = w.points[..count].iter().map(|p| p.total_normal_impulse.0[l]).sum();
-        let tangent_speed = w.tangent_speed.0[l];
-        for i in 0..count {
-            let wp = &w.points[i];
-            let (normal, total_normal, max) = (
-                h.points[i].normal_impulse.0[l],
-                wp.total_normal_impulse.0[l],
-                wp.max_normal_impulse.0[l],
-            );
-            let (was_stick, fresh) = (cold.stick[i][l], cold.fresh[i][l]);
-            let slip_speed = vt[i].0[l].abs();
-            let loaded = max > 0.0;
-            let mut stick = was_stick;
-            if loaded {
-                if stick && patch_saturated && slip_speed > ctx.stick_speed {
-                    stick = false;
-                } else if !stick && slip_speed < ctx.stick_speed {
-                    stick = true;
-                }
-            }
-            o.points[i] = PointState {
-                normal_impulse: normal,
-                tangent_impulse: tangent,
-                total_normal_impulse: total_normal,
-                total_tangent_impulse: if count == 2 && sum_total_n > 0.0 {
-                    sum_total_t * total_normal / sum_total_n
-                } else {
-                    total_tangent
-                },
-                max_normal_impulse: max,
-                state: if stick {
+    // Four lanes at once; every expression is the scalar store's, in its order.
+    let zero = F4::ZERO;
+    let count = F4(cold.count.map(|c| c.min(2) as f32));
+    let (has0, two) = (count.ge(F4::splat(1.0)), count.ge(F4::splat(2.0)));
+    let share = two.select(F4::splat(0.5), F4::splat(1.0));
+    let (tangent, total_tangent) = (share * h.tangent_impulse, share * w.total_tangent_impulse);
+    // Sums over the points from 0.0 (the scalar loop's start).
+    let sum_over = |x0: F4, x1: F4| {
+        let first = zero + x0;
+        two.select(first + x1, has0.select(first, zero))
+    };
+    let (n0, n1) = (h.points[0].normal_impulse, h.points[1].normal_impulse);
+    let (sum_t, sum_n) = (sum_over(tangent, tangent), sum_over(n0, n1));
+    let patch_saturated = sum_t.abs().ge(F4::splat(0.999) * F4(cold.mu_s) * sum_n) & has0 & w.saturated;
+    // Only read where there are two points (`Sum` from −0.0: the plain sum of the two).
+    let sum_total_t = total_tangent + total_tangent;
+    let (tn0, tn1) = (w.points[0].total_normal_impulse, w.points[1].total_normal_impulse);
+    let sum_total_n = tn0 + tn1;
+    let stick_speed = F4::splat(ctx.stick_speed);
+    let restitution = F4(cold.restitution);
+    let threshold = -F4(cold.restitution_threshold);
+    let mut points = [[PointState::default(); 2]; LANES];
+    for i in 0..2 {
+        let (wp, normal) = (&w.points[i], h.points[i].normal_impulse);
+        let (total_normal, max) = (wp.total_normal_impulse, wp.max_normal_impulse);
+        let (was_stick, fresh) = (M4::from_bools(cold.stick[i]), M4::from_bools(cold.fresh[i]));
+        let slip_speed = vt[i].abs();
+        let loaded = max.gt(zero);
+        // Loaded points change state: a sticking one slips when the patch is saturated and
+        // it moves; a sliding one sticks when it has stopped.
+        let stays = !(patch_saturated & slip_speed.gt(stick_speed));
+        let stick =
+            (loaded & ((was_stick & stays) | (!was_stick & slip_speed.lt(stick_speed)))) | (!loaded & was_stick);
+        let total_tangent_out =
+            (two & sum_total_n.gt(zero)).select(sum_total_t * total_normal / sum_total_n, total_tangent);
+        let drift = (stick & was_stick & loaded).select(
+            disp[i] + F4(cold.base_drift[i]) - w.tangent_speed * F4::splat(ctx.dt),
+            zero,
+        );
+        // next_preload, with `bounces` of the restitution pass.
+        let approach = wp.approach;
+        let bounced = restitution.gt(zero) & threshold.ge(approach) & max.gt(zero);
+        let released = zero.ge(max) | (fresh & bounced);
+        let kept = normal.lt(F4::splat(0.5) * wp.preload).select(zero, wp.preload);
+        let preload = released.select(zero, fresh.select(normal, kept));
+        for (l, lane) in points.iter_mut().enumerate() {
+            lane[i] = PointState {
+                normal_impulse: normal.0[l],
+                tangent_impulse: tangent.0[l],
+                total_normal_impulse: total_normal.0[l],
+                total_tangent_impulse: total_tangent_out.0[l],
+                max_normal_impulse: max.0[l],
+                state: if stick.lane(l) {
                     FrictionState::Stick
                 } else {
                     FrictionState::Slip
                 },
                 fresh: false,
-                drift: if stick && was_stick && loaded {
-                    disp[i].0[l] + cold.base_drift[i][l] - tangent_speed * ctx.dt
-                } else {
-                    0.0
-                },
-                slip_speed,
-                preload: next_preload(
-                    wp.preload.0[l],
-                    normal,
-                    max,
-                    fresh,
-                    bounces(
-                        cold.restitution[l],
-                        cold.restitution_threshold[l],
-                        wp.approach.0[l],
-                        max,
-                    ),
-                ),
-                approach_velocity: wp.approach.0[l],
+                drift: drift.0[l],
+                slip_speed: slip_speed.0[l],
+                preload: preload.0[l],
+                approach_velocity: approach.0[l],
             };
         }
+    }
+    for (l, o) in out.iter_mut().enumerate() {
+        o.count = cold.count[l].min(2);
+        o.rolling_impulse = h.rolling_impulse.0[l];
+        o.points = points[l];
     }
 }
 

@@ -237,6 +237,12 @@ impl M4 {
         self.0[i] != 0
     }
 
+    /// A mask from four booleans.
+    #[inline(always)]
+    pub fn from_bools(b: [bool; LANES]) -> M4 {
+        M4(b.map(|x| if x { u32::MAX } else { 0 }))
+    }
+
     /// Whether some lane is true.
     #[inline(always)]
     pub fn any(self) -> bool {
