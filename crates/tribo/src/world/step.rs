@@ -497,7 +497,7 @@ impl World {
             contacts: &mut solver,
         };
         if ctx.parallel {
-            // Threads share the states (`SharedState`, one per cache line) for the substeps,
+            // Threads share the states (`SharedState`, 32 bytes each) for the substeps,
             // then copy them back; the shared array is kept from step to step.
             let mut shared = core::mem::take(&mut self.shared_states);
             shared.clear();
