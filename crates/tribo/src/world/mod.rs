@@ -150,6 +150,9 @@ pub struct World {
     pub(crate) scratch_mark: Vec<bool>,
     /// Scratch: one flag per body slot (active bodies, see `collect_active_contacts`).
     pub(crate) scratch_flags: Vec<bool>,
+    /// Scratch of a parallel finalize: per awake body, its one shape's next box when it
+    /// stays inside the fat box (see `World::finalize`).
+    pub(crate) scratch_boxes: Vec<Option<Aabb>>,
     /// Per body slot, what the solver's constraints need of it (rebuilt every step).
     pub(crate) solver_bodies: Vec<crate::solver::SolverBody>,
     pub(crate) step_count: u64,
@@ -200,6 +203,7 @@ impl World {
             scratch_f32: Vec::new(),
             scratch_mark: Vec::new(),
             scratch_flags: Vec::new(),
+            scratch_boxes: Vec::new(),
             shared_states: Vec::new(),
             solver_bodies: Vec::new(),
             step_count: 0,
@@ -827,24 +831,14 @@ impl World {
             return None;
         };
         let check = check && dt > 0.0 && b.body_type == BodyType::Dynamic;
-        // The solver never moves a body faster than the world's speed limit; a velocity
-        // above it (left by the last pass of a violent step) must not sweep a box across
-        // the world, which would pair it with every shape.
-        let (xf, speed, limit) = (b.xf, b.v.length(), self.def.max_linear_speed);
-        let v = if speed > limit { b.v * (limit / speed) } else { b.v };
+        let (xf, v) = (b.xf, box_velocity(b, self.def.max_linear_speed));
         for (k, &sid) in b.shapes.iter().enumerate().skip(first) {
             let Some(s) = self.shapes.get_mut(sid.index, sid.generation) else {
                 continue;
             };
-            let tight = s.geometry.aabb(xf);
-            // A static shape the body has no pair with had its fat box (its box grown by
-            // the speculative distance) apart from this one's, so a shape poking out of its
-            // fat box by less than the speculative distance plus the slop overlaps it by the
-            // slop at most: only a shape further out can be where nothing stopped it.
-            if check && !s.fat_aabb.expand(SPECULATIVE_DISTANCE + LINEAR_SLOP).contains(tight) {
+            let Some(aabb) = next_box(s, xf, v, dt, check) else {
                 return Some(k);
-            }
-            let aabb = swept_box(tight, v, dt, s.sweep_free);
+            };
             s.aabb = aabb;
             if !s.fat_aabb.contains(aabb) || dt == 0.0 {
                 let fat = aabb.expand(s.margin);
@@ -992,6 +986,32 @@ pub(crate) fn shape_box(geometry: &Shape, xf: Transform, v: Vec2, dt: f32, free:
 }
 
 /// [`shape_box`] from the shape's tight box at its pose.
+/// The velocity a body's boxes are swept along: the solver never moves a body faster than
+/// the world's speed limit; a velocity above it (left by the last pass of a violent step)
+/// must not sweep a box across the world, which would pair it with every shape.
+pub(crate) fn box_velocity(b: &Body, limit: f32) -> Vec2 {
+    let speed = b.v.length();
+    if speed > limit {
+        b.v * (limit / speed)
+    } else {
+        b.v
+    }
+}
+
+/// A shape's box for the next step at the body's pose `xf` (swept along `v` for `dt`), or
+/// `None` when `check` finds the shape escaped: a static shape the body has no pair with
+/// had its fat box (its box grown by the speculative distance) apart from this one's, so a
+/// shape poking out of its fat box by less than the speculative distance plus the slop
+/// overlaps it by the slop at most: only a shape further out can be where nothing stopped
+/// it ([`World::stop_at_static_shapes`]).
+pub(crate) fn next_box(s: &ShapeRecord, xf: Transform, v: Vec2, dt: f32, check: bool) -> Option<Aabb> {
+    let tight = s.geometry.aabb(xf);
+    if check && !s.fat_aabb.expand(SPECULATIVE_DISTANCE + LINEAR_SLOP).contains(tight) {
+        return None;
+    }
+    Some(swept_box(tight, v, dt, s.sweep_free))
+}
+
 fn swept_box(tight: Aabb, v: Vec2, dt: f32, free: f32) -> Aabb {
     let aabb = tight.expand(SPECULATIVE_DISTANCE);
     let motion = v.length() * dt;

@@ -18,10 +18,11 @@ use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::{Candidate, Candidates};
 use crate::solver::contact_solver::{ConstraintBodies, ContactInput};
 use crate::solver::{
-    for_each_mut3, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints, StepContext,
+    for_each_mut, for_each_mut3, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints, StepContext,
 };
 use crate::world::Arena;
 use crate::world::BodyId;
+use crate::world::{box_velocity, next_box};
 
 impl World {
     /// Advances the world by `dt` [s] (usually 1/60) in `WorldDef::substeps` substeps.
@@ -566,6 +567,28 @@ impl World {
                 b.sleep_time = 0.0;
             }
         });
+        // With threads, the boxes of one-shape bodies are computed in parallel first; a box
+        // that stays inside its fat box is then only stored by the serial pass below.
+        let mut boxes = core::mem::take(&mut self.scratch_boxes);
+        boxes.clear();
+        if parallel {
+            boxes.resize(self.states.len(), None);
+            let (bodies, shapes, sims, limit) = (&self.bodies, &self.shapes, &self.sims, self.def.max_linear_speed);
+            for_each_mut(parallel, &mut boxes, BODY_CHUNK, |k, out| {
+                let Some(b) = sims.get(k).filter(|_| k > 0).and_then(|sim| bodies.at(sim.body)) else {
+                    return;
+                };
+                let [sid] = b.shapes[..] else { return };
+                if b.non_finite || dt <= 0.0 {
+                    return;
+                }
+                let Some(s) = shapes.get(sid.index, sid.generation) else {
+                    return;
+                };
+                let check = b.body_type == BodyType::Dynamic;
+                *out = next_box(s, b.xf, box_velocity(b, limit), dt, check).filter(|aabb| s.fat_aabb.contains(*aabb));
+            });
+        }
         // Fat boxes and the trees, in solver order (the trees are shared).
         for k in 1..self.states.len() {
             let bi = self.sims[k].body;
@@ -579,8 +602,17 @@ impl World {
                 self.non_finite.push(id);
                 continue;
             }
-            self.refresh_body_proxies(bi, dt);
+            let fitted = boxes.get(k).copied().flatten();
+            match (fitted, b.shapes.first().copied()) {
+                (Some(aabb), Some(sid)) => {
+                    if let Some(s) = self.shapes.get_mut(sid.index, sid.generation) {
+                        s.aabb = aabb;
+                    }
+                }
+                _ => self.refresh_body_proxies(bi, dt),
+            }
         }
+        self.scratch_boxes = boxes;
     }
 
     /// Islands (awake dynamic bodies linked by touching contacts) whose every body has
