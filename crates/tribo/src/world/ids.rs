@@ -105,6 +105,15 @@ impl<T> Arena<T> {
         }
     }
 
+    /// Asks for the cache line of a slot's first bytes ahead of its use (a hint: reads
+    /// nothing, see [`crate::solver::prefetch_lines`]).
+    #[inline]
+    pub fn prefetch(&self, index: u32) {
+        if let Some(slot) = self.slots.get(index as usize) {
+            crate::solver::prefetch_lines(slot, 1);
+        }
+    }
+
     /// The value at a slot index, whatever its generation (internal links).
     #[inline]
     pub fn at(&self, index: u32) -> Option<&T> {

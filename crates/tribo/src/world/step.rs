@@ -105,7 +105,10 @@ impl World {
         let use_flat = self.broad_phase.prepare_queries(moved.len());
         let mut new_pairs: Vec<u64> = Vec::new();
         let mut hits: Vec<u32> = Vec::new();
-        for &si in &moved {
+        for (j, &si) in moved.iter().enumerate() {
+            // The moved shapes' records, their bodies and the bodies' key lists are asked
+            // for a few shapes ahead (each needs the one before it: a chain of misses).
+            self.prefetch_pair_data(&moved, j);
             let Some(s) = self.shapes.at(si) else { continue };
             let Some(body) = self.bodies.at(s.body.index) else {
                 continue;
@@ -159,6 +162,26 @@ impl World {
         new_pairs.dedup();
         for key in new_pairs {
             self.create_contact((key >> 32) as u32, key as u32);
+        }
+    }
+
+    /// [`World::update_pairs`]' prefetch at the `j`-th moved shape: the shape record
+    /// [`PAIR_PREFETCH`] ahead, the body of the one half as far ahead (its shape is then
+    /// cached), the key list of the next one's body.
+    #[inline]
+    fn prefetch_pair_data(&self, moved: &[u32], j: usize) {
+        if let Some(&far) = moved.get(j + PAIR_PREFETCH) {
+            self.shapes.prefetch(far);
+        }
+        if let Some(s) = moved.get(j + PAIR_PREFETCH / 2).and_then(|&mid| self.shapes.at(mid)) {
+            self.bodies.prefetch(s.body.index);
+        }
+        let near = moved.get(j + 1).and_then(|&near| self.shapes.at(near));
+        if let Some(key) = near
+            .and_then(|s| self.bodies.at(s.body.index))
+            .and_then(|b| b.contact_keys.first())
+        {
+            crate::solver::prefetch(key);
         }
     }
 
@@ -711,6 +734,9 @@ const CONTACT_CHUNK: usize = 256;
 /// Contact lists up to this long are searched for an existing pair instead of the pair
 /// table (a few keys in one cache line beat a hash probe into a large table).
 const SHORT_CONTACT_LIST: usize = 16;
+
+/// How many moved shapes ahead [`World::update_pairs`] asks for their records.
+const PAIR_PREFETCH: usize = 8;
 
 /// The solver's input of a touching contact with an awake dynamic side (`None` otherwise).
 fn candidate(ci: u32, c: &Contact, solver_bodies: &[SolverBody]) -> Option<Candidate> {
