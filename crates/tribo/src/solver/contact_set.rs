@@ -758,10 +758,10 @@ impl ContactSolver {
     /// those run the per-colour path.
     fn team_loop(&mut self, ctx: &StepContext, sims: &[BodySim], states: &[SharedState], times: &mut [f32; 5]) -> bool {
         let threads = rayon::current_num_threads();
-        let soft = self.soft;
         if threads < 2 || !self.overflow.is_empty() || !self.groups.is_empty() || self.wide.is_empty() {
             return false;
         }
+        let soft = self.soft;
         // Each colour in blocks of TEAM_BLOCK groups. Thread k first takes the k-th share of
         // the blocks (the same bodies in every colour and pass, so their states stay in its
         // cache), then helps with the blocks the others have not started, from the far end:

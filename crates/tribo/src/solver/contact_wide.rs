@@ -93,8 +93,7 @@ pub(crate) struct WideHead {
 /// The rest of four contact constraints, one per lane (see the module docs): what only
 /// the solve passes read.
 ///
-/// The passes are bound by memory traffic, so what costs a few instructions to derive is
-/// not stored: the softness (from whether a side is static), K⁻¹ (from K and 1/det K),
+/// What costs a few instructions to derive is not stored (less for every pass to stream): the softness (from whether a side is static), K⁻¹ (from K and 1/det K),
 /// 1/k11 and 1/k22 (the points' normal masses where the block applies), the friction row's
 /// anchors (from the points' anchors) and the rolling mass (from the inverse inertias).
 /// 400 bytes (was 608).
@@ -261,13 +260,7 @@ fn tangent_share(h: &WideHead, i: usize) -> F4 {
 /// static softness, `contact_solver::build_constraint`).
 #[inline(always)]
 fn static_lanes(h: &WideHead) -> M4 {
-    M4(core::array::from_fn(|l| {
-        if h.index_a[l] == 0 || h.index_b[l] == 0 {
-            u32::MAX
-        } else {
-            0
-        }
-    }))
+    M4::from_bools(core::array::from_fn(|l| h.index_a[l] == 0 || h.index_b[l] == 0))
 }
 
 /// The softness of each lane: (bias rate, mass scale, impulse scale).
@@ -669,9 +662,8 @@ pub(crate) fn store_group<S: StateRead>(
     }
     // Four lanes at once; every expression is the scalar store's, in its order.
     let zero = F4::ZERO;
-    let count = F4(cold.count.map(|c| c.min(2) as f32));
-    let (has0, two) = (count.ge(F4::splat(1.0)), count.ge(F4::splat(2.0)));
-    let share = two.select(F4::splat(0.5), F4::splat(1.0));
+    let has0 = M4::from_bools(cold.count.map(|c| c >= 1));
+    let (two, share) = (h.two_points, tangent_share(h, 0));
     let (tangent, total_tangent) = (share * h.tangent_impulse, share * w.total_tangent_impulse);
     // Sums over the points from 0.0 (the scalar loop's start).
     let sum_over = |x0: F4, x1: F4| {
@@ -688,7 +680,10 @@ pub(crate) fn store_group<S: StateRead>(
     let stick_speed = F4::splat(ctx.stick_speed);
     let restitution = F4(cold.restitution);
     let threshold = -F4(cold.restitution_threshold);
-    let mut points = [[PointState::default(); 2]; LANES];
+    for (o, (&count, &rolling)) in out.iter_mut().zip(cold.count.iter().zip(&h.rolling_impulse.0)) {
+        o.count = count.min(2);
+        o.rolling_impulse = rolling;
+    }
     for i in 0..2 {
         let (wp, normal) = (&w.points[i], h.points[i].normal_impulse);
         let (total_normal, max) = (wp.total_normal_impulse, wp.max_normal_impulse);
@@ -712,8 +707,8 @@ pub(crate) fn store_group<S: StateRead>(
         let released = zero.ge(max) | (fresh & bounced);
         let kept = normal.lt(F4::splat(0.5) * wp.preload).select(zero, wp.preload);
         let preload = released.select(zero, fresh.select(normal, kept));
-        for (l, lane) in points.iter_mut().enumerate() {
-            lane[i] = PointState {
+        for (l, o) in out.iter_mut().enumerate() {
+            o.points[i] = PointState {
                 normal_impulse: normal.0[l],
                 tangent_impulse: tangent.0[l],
                 total_normal_impulse: total_normal.0[l],
@@ -731,11 +726,6 @@ pub(crate) fn store_group<S: StateRead>(
                 approach_velocity: approach.0[l],
             };
         }
-    }
-    for (l, o) in out.iter_mut().enumerate() {
-        o.count = cold.count[l].min(2);
-        o.rolling_impulse = h.rolling_impulse.0[l];
-        o.points = points[l];
     }
 }
 

@@ -222,7 +222,6 @@ impl F4 {
 }
 
 #[inline(always)]
-#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
 fn mask(b: bool) -> u32 {
     if b {
         u32::MAX
@@ -240,7 +239,7 @@ impl M4 {
     /// A mask from four booleans.
     #[inline(always)]
     pub fn from_bools(b: [bool; LANES]) -> M4 {
-        M4(b.map(|x| if x { u32::MAX } else { 0 }))
+        M4(b.map(mask))
     }
 
     /// Whether some lane is true.

@@ -985,7 +985,6 @@ pub(crate) fn shape_box(geometry: &Shape, xf: Transform, v: Vec2, dt: f32, free:
     swept_box(geometry.aabb(xf), v, dt, free)
 }
 
-/// [`shape_box`] from the shape's tight box at its pose.
 /// The velocity a body's boxes are swept along: the solver never moves a body faster than
 /// the world's speed limit; a velocity above it (left by the last pass of a violent step)
 /// must not sweep a box across the world, which would pair it with every shape.
@@ -1012,6 +1011,7 @@ pub(crate) fn next_box(s: &ShapeRecord, xf: Transform, v: Vec2, dt: f32, check: 
     Some(swept_box(tight, v, dt, s.sweep_free))
 }
 
+/// [`shape_box`] from the shape's tight box at its pose.
 fn swept_box(tight: Aabb, v: Vec2, dt: f32, free: f32) -> Aabb {
     let aabb = tight.expand(SPECULATIVE_DISTANCE);
     let motion = v.length() * dt;

@@ -594,7 +594,7 @@ impl World {
         // that stays inside its fat box is then only stored by the serial pass below.
         let mut boxes = core::mem::take(&mut self.scratch_boxes);
         boxes.clear();
-        if parallel {
+        if parallel && dt > 0.0 {
             boxes.resize(self.states.len(), None);
             let (bodies, shapes, sims, limit) = (&self.bodies, &self.shapes, &self.sims, self.def.max_linear_speed);
             for_each_mut(parallel, &mut boxes, BODY_CHUNK, |k, out| {
@@ -602,7 +602,7 @@ impl World {
                     return;
                 };
                 let [sid] = b.shapes[..] else { return };
-                if b.non_finite || dt <= 0.0 {
+                if b.non_finite {
                     return;
                 }
                 let Some(s) = shapes.get(sid.index, sid.generation) else {
