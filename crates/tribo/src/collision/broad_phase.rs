@@ -61,8 +61,9 @@ pub(crate) struct BroadPhase {
     pub trees: [DynamicTree; 2],
     /// Shape indices whose proxies moved (or were created) since the last pair update.
     pub moved: Vec<u32>,
-    /// Existing pairs: pair key → contact index. Used for lookups only, never iterated,
-    /// so hash order cannot leak into the simulation.
+    /// Existing pairs: pair key → contact index. Used for lookups only, never iterated in
+    /// an order that matters (the contact renumbering replaces each value on its own), so
+    /// hash order cannot leak into the simulation.
     pub pairs: HashMap<u64, u32, BuildPairHasher>,
     /// Query copies of the trees ([`FlatTree`]), made when a step queries many proxies.
     pub flat: [FlatTree; 2],

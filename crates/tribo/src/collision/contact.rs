@@ -49,6 +49,9 @@ pub(crate) struct PointState {
     pub approach_velocity: f32,
 }
 
+/// [`Contact::colour`] of a contact not yet solved, or solved in the overflow list.
+pub(crate) const NO_COLOUR: u8 = u8::MAX;
+
 /// A contact between two shapes (internal record).
 ///
 /// Laid out by use (`repr(C)`, whole cache lines): the passes in contact order that touch
@@ -61,6 +64,9 @@ pub(crate) struct PointState {
 pub(crate) struct Contact {
     /// Whether the manifold has points.
     pub touching: bool,
+    /// The solver colour the contact had when last solved ([`NO_COLOUR`]: none), which
+    /// the colouring tries first (see `solver::contact_set`).
+    pub colour: u8,
     /// Body slot indices.
     pub body_a: u32,
     pub body_b: u32,
@@ -290,6 +296,7 @@ pub(crate) fn blank_contact() -> Contact {
         },
         body_a: 0,
         body_b: 1,
+        colour: NO_COLOUR,
         manifold: Manifold::default(),
         points: [PointState::default(); MAX_MANIFOLD_POINTS],
         material: MixedMaterial::default(),

@@ -38,7 +38,7 @@ use super::{
     any_load, for_each_mut, for_each_mut3, integrate_position_one, integrate_velocity_one, BodySim, ConstraintSet,
     SharedState, SpinBarrier, StateCell, StateRead, StepContext,
 };
-use crate::collision::contact::Contact;
+use crate::collision::contact::{Contact, NO_COLOUR};
 use crate::math::Vec2;
 use crate::world::Stopwatch;
 
@@ -62,15 +62,18 @@ pub(crate) struct Candidate {
     pub contact: u32,
     /// [`fast_first`] of the input.
     fast: bool,
+    /// The colour the contact had when last solved ([`NO_COLOUR`]: none), tried first.
+    colour: u8,
     pub bodies: ConstraintBodies,
     pub input: ContactInput,
 }
 
 impl Candidate {
-    pub fn new(contact: u32, bodies: ConstraintBodies, input: ContactInput) -> Candidate {
+    pub fn new(contact: u32, colour: u8, bodies: ConstraintBodies, input: ContactInput) -> Candidate {
         Candidate {
             contact,
             fast: fast_first(&input),
+            colour,
             bodies,
             input,
         }
@@ -80,6 +83,7 @@ impl Candidate {
     pub const SKIP: Candidate = Candidate {
         contact: u32::MAX,
         fast: false,
+        colour: NO_COLOUR,
         bodies: ConstraintBodies {
             index_a: 0,
             index_b: 0,
@@ -146,6 +150,12 @@ pub(crate) struct ContactSolver {
     groups: Vec<Group>,
     /// `wide[ranges[k].0 .. ranges[k].1]`: the groups of the k-th non-empty colour.
     ranges: Vec<(u32, u32)>,
+    /// The colour of each group (stored into its contacts, tried first next step).
+    group_colour: Vec<u8>,
+    /// The contact in each lane (group by group; `u32::MAX`: empty lane).
+    layout: Vec<u32>,
+    /// `layout` is the last step's and not yet taken ([`ContactSolver::take_layout`]).
+    layout_fresh: bool,
     /// Candidate index of each lane of each group (`u32::MAX`: empty lane).
     lane_candidates: Vec<[u32; LANES]>,
     /// What each lane stores into its contact (the store's first half, in group order).
@@ -295,9 +305,18 @@ impl ContactSolver {
             );
             let busy = (if da { self.used[b.index_a as usize] } else { 0 })
                 | (if db { self.used[b.index_b as usize] } else { 0 });
-            // The lowest free colour below DYNAMIC_COLORS, or the highest free one from 1 up
-            // (bit scans of the free colours).
-            let colour = if da && db {
+            // The colour of the last step when it is still free (a pile keeps its layout,
+            // see `layout_order`), else the lowest free colour below DYNAMIC_COLORS, or the
+            // highest free one from 1 up (bit scans of the free colours).
+            let open = if da && db {
+                DYNAMIC_COLOR_BITS
+            } else {
+                STATIC_COLOR_BITS
+            };
+            let kept = 1u32.checked_shl(cand.colour as u32).unwrap_or(0) & open & !busy;
+            let colour = if kept != 0 {
+                Some(cand.colour as usize)
+            } else if da && db {
                 let free = !busy & DYNAMIC_COLOR_BITS;
                 (free != 0).then(|| free.trailing_zeros() as usize)
             } else {
@@ -325,6 +344,7 @@ impl ContactSolver {
         let mut next_slow = [0u32; COLORS];
         let mut groups = 0u32;
         self.ranges.clear();
+        self.group_colour.clear();
         for k in 0..COLORS {
             next[k] = groups * LANES as u32;
             next_slow[k] = next[k] + fast_counts[k];
@@ -332,6 +352,7 @@ impl ContactSolver {
             groups += counts[k].div_ceil(LANES as u32);
             if groups > start {
                 self.ranges.push((start, groups));
+                self.group_colour.resize(groups as usize, k as u8);
             }
         }
         // Every lane is written whole below (packed or cleared): no memset.
@@ -347,6 +368,8 @@ impl ContactSolver {
         self.slots.clear();
         self.lane_candidates.clear();
         self.lane_candidates.resize(groups as usize, [u32::MAX; LANES]);
+        self.layout.clear();
+        self.layout.resize(groups as usize * LANES, u32::MAX);
         // Reads only the colour bytes (and the rare overflow candidates), not the candidates.
         for (i, &colour) in self.colours.iter().enumerate() {
             let slot = if colour == OVERFLOW {
@@ -369,6 +392,7 @@ impl ContactSolver {
                 *next += 1;
                 let (group, lane) = (at / LANES as u32, at % LANES as u32);
                 self.lane_candidates[group as usize][lane as usize] = i as u32;
+                self.layout[at as usize] = self.contact_of[i];
                 Slot::Wide {
                     group,
                     lane: lane as u8,
@@ -411,12 +435,33 @@ impl ContactSolver {
                 }
             }
         }
+        self.layout_fresh = true;
         self.loaded = any_load(sims);
         if self.loaded {
             self.build_groups(light, candidates);
         }
         #[cfg(debug_assertions)]
         self.check_colours(states.len());
+    }
+
+    /// The contacts solved in the last step in the order the solver laid them out (group
+    /// by group, lane by lane, then the overflow list), into `out`; returns how many of
+    /// them do not follow the one before in contact order (few: the contacts already lie
+    /// in the layout's order). Nothing once taken: the contacts may have been renumbered.
+    pub fn take_layout(&mut self, out: &mut Vec<u32>) -> usize {
+        out.clear();
+        if !core::mem::take(&mut self.layout_fresh) {
+            return 0;
+        }
+        let lanes = self.layout.iter().copied().filter(|&contact| contact != u32::MAX);
+        let mut breaks = 0;
+        let mut last = u32::MAX;
+        for contact in lanes.chain(self.overflow.iter().map(|oc| oc.contact)) {
+            breaks += (contact != last.wrapping_add(1)) as usize;
+            last = contact;
+            out.push(contact);
+        }
+        breaks
     }
 
     /// Debug builds: no moving body appears twice in one colour (the threads' shared
@@ -527,10 +572,14 @@ impl ContactSolver {
                     continue;
                 };
                 match this.slots.get(first + k) {
-                    Some(&Slot::Wide { group, lane }) => this.stored[group as usize][lane as usize].write_into(c),
+                    Some(&Slot::Wide { group, lane }) => {
+                        this.stored[group as usize][lane as usize].write_into(c);
+                        c.colour = this.group_colour.get(group as usize).copied().unwrap_or(NO_COLOUR);
+                    }
                     Some(&Slot::Overflow(o)) => {
                         if let Some(oc) = this.overflow.get(o as usize) {
                             store_impulses(oc, c, states, ctx);
+                            c.colour = NO_COLOUR;
                         }
                     }
                     None => {}
@@ -579,7 +628,7 @@ impl ContactSolver {
             }
             let mut out = [StoredContact::default(); LANES];
             contact_wide::store_group(h, w, cold, states, ctx, &mut out);
-            let Some(lanes) = self.lane_candidates.get(g) else {
+            let (Some(lanes), Some(&colour)) = (self.lane_candidates.get(g), self.group_colour.get(g)) else {
                 continue;
             };
             for ((s, &cand), &contact) in out.iter().zip(lanes).zip(&cold.contact) {
@@ -588,12 +637,14 @@ impl ContactSolver {
                 }
                 if let Some(Some(c)) = contacts.get_mut(contact as usize) {
                     s.write_into(c);
+                    c.colour = colour;
                 }
             }
         }
         for oc in &self.overflow {
             if let Some(Some(c)) = contacts.get_mut(oc.contact as usize) {
                 store_impulses(oc, c, states, ctx);
+                c.colour = NO_COLOUR;
             }
         }
     }

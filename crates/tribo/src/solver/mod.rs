@@ -352,22 +352,39 @@ pub(crate) struct BodySim {
     pub jointed: bool,
 }
 
-/// What the constraint build needs of a body, one per body slot (static and sleeping
-/// bodies too: their centre anchors the contacts), in a compact array filled at the start
-/// of the solve: the per-contact pass reads 24 bytes per body, not the body's record.
+/// What the narrow phase and the constraint build need of a body, one per body slot
+/// (static and sleeping bodies too: their poses meet the awake bodies' shapes and their
+/// centres anchor the contacts), in a compact array filled at the start of the step: the
+/// per-contact passes read one cache line per body, not the body's record (several lines,
+/// its fields where the compiler put them), in whatever order the contacts come.
 #[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(64))]
 pub(crate) struct SolverBody {
     /// Index of the body's state in the solver arrays (0 = none: static or asleep).
     pub index: u32,
     /// Awake and dynamic: its contacts are solved this step.
     pub awake_dynamic: bool,
+    /// Awake and not static: its contacts are updated this step.
+    pub active: bool,
     /// Inverse mass [1/kg] and inverse rotational inertia [1/(kg·m²)] as the solver sees
     /// them (0 for bodies without a state).
     pub inv_mass: f32,
     pub inv_i: f32,
     /// World centre of mass [m].
     pub center: Vec2,
+    /// Pose of the body origin at the start of the step.
+    pub xf: crate::math::Transform,
+    /// Velocity at the start of the step [m/s], [rad/s].
+    pub v: Vec2,
+    pub w: f32,
+    /// Largest distance from the centre of mass to any of the body's shapes' points [m].
+    pub max_extent: f32,
+    /// Largest distance from the body origin to any of its shapes' points (bounded:
+    /// `max_extent` + |local centre|) [m].
+    pub reach: f32,
 }
+
+const _: () = assert!(core::mem::size_of::<SolverBody>() == 64);
 
 #[cfg(test)]
 impl StepContext {

@@ -8,7 +8,8 @@ use std::time::Instant;
 pub struct Profile {
     /// The whole step [ms].
     pub step: f32,
-    /// Broad phase: new pairs from moved proxies [ms].
+    /// Broad phase: new pairs from moved proxies; and the contacts' renumbering in a step
+    /// that renumbers them [ms].
     pub pairs: f32,
     /// Narrow phase: manifolds, begin/end events [ms].
     pub collide: f32,

@@ -6,9 +6,9 @@
 //! 4. [`World::finalize`]: poses from the solver, swept fat boxes, sleep timers.
 //! 5. [`World::update_sleep`]: islands that rested long enough fall asleep.
 
-use super::{ContactBeginEvent, ContactEndEvent, Stopwatch, World};
+use super::{ContactBeginEvent, ContactEndEvent, ShapeBounds, Stopwatch, World};
 use crate::collision::broad_phase::{MOVING_TREE, STATIC_TREE};
-use crate::collision::contact::{pair_key, Contact, FarPoses, NarrowOutcome, PointState};
+use crate::collision::contact::{pair_key, Contact, FarPoses, NarrowOutcome, PointState, NO_COLOUR};
 use crate::dynamics::body::Body;
 use crate::dynamics::shape::ShapeRecord;
 use crate::dynamics::{mix, BodyType};
@@ -21,8 +21,8 @@ use crate::solver::{
     for_each_mut, for_each_mut3, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints, StepContext,
 };
 use crate::world::Arena;
-use crate::world::BodyId;
 use crate::world::{box_velocity, next_box};
+use crate::world::{BodyId, ShapeId};
 
 impl World {
     /// Advances the world by `dt` [s] (usually 1/60) in `WorldDef::substeps` substeps.
@@ -53,6 +53,7 @@ impl World {
     fn run_step(&mut self, dt: f32, parallel: bool) {
         let mut total = Stopwatch::start();
         let mut lap = Stopwatch::start();
+        self.reorder_contacts();
         self.update_pairs();
         self.profile.pairs = lap.lap();
         self.prepare_bodies();
@@ -218,6 +219,7 @@ impl World {
             rolling_radius: rolling_radius(&a.geometry).max(rolling_radius(&b.geometry)),
             rolling_impulse: 0.0,
             touching: false,
+            colour: NO_COLOUR,
             basis: Default::default(),
             far_bound: 0.0,
             far: Default::default(),
@@ -261,11 +263,11 @@ impl World {
         // solvable one its candidate): no clearing.
         outcomes.resize(self.contacts.len(), (NarrowOutcome::Skipped, false));
         candidates.resize(self.contacts.len(), Candidate::SKIP);
-        let (bodies, shapes, solver_bodies) = (&self.bodies, &self.shapes, &self.solver_bodies);
+        let (shapes, solver_bodies, bounds) = (&self.shapes, &self.solver_bodies, &self.shape_bounds);
         // Updates one contact, writes its outcome and, if it is touching with an awake
         // dynamic side, its candidate.
         let update = |ci: usize, c: &mut Contact, cand: &mut Candidate, out: &mut (NarrowOutcome, bool)| {
-            let outcome = narrow_phase(c, bodies, shapes, dt);
+            let outcome = narrow_phase(c, solver_bodies, bounds, shapes, dt);
             let solvable = matches!(outcome, NarrowOutcome::Updated { touching: true, .. })
                 && match candidate(ci as u32, c, solver_bodies) {
                     Some(x) => {
@@ -467,17 +469,27 @@ impl World {
             let (Some(b), Some(sb)) = (self.bodies.at(bi), self.solver_bodies.get_mut(bi as usize)) else {
                 continue;
             };
-            sb.center = b.center;
-            if !b.awake || b.body_type == BodyType::Static {
+            let active = b.awake && b.body_type != BodyType::Static;
+            *sb = SolverBody {
+                index: 0,
+                awake_dynamic: false,
+                active,
+                inv_mass: 0.0,
+                inv_i: 0.0,
+                center: b.center,
+                xf: b.xf,
+                v: b.v,
+                w: b.w,
+                max_extent: b.max_extent,
+                reach: b.max_extent + b.local_center.length(),
+            };
+            if !active {
                 continue;
             }
-            *sb = SolverBody {
-                index: self.states.len() as u32,
-                awake_dynamic: b.is_dynamic(),
-                inv_mass: b.inv_mass,
-                inv_i: b.inv_inertia,
-                center: b.center,
-            };
+            sb.index = self.states.len() as u32;
+            sb.awake_dynamic = b.is_dynamic();
+            sb.inv_mass = b.inv_mass;
+            sb.inv_i = b.inv_inertia;
             self.states.push(BodyState {
                 v: b.v,
                 w: b.w,
@@ -630,6 +642,9 @@ impl World {
                 (Some(aabb), Some(sid)) => {
                     if let Some(s) = self.shapes.get_mut(sid.index, sid.generation) {
                         s.aabb = aabb;
+                        if let Some(bounds) = self.shape_bounds.get_mut(sid.index as usize) {
+                            bounds.aabb = aabb;
+                        }
                     }
                 }
                 _ => self.refresh_body_proxies(bi, dt),
@@ -752,6 +767,7 @@ fn candidate(ci: u32, c: &Contact, solver_bodies: &[SolverBody]) -> Option<Candi
     }
     Some(Candidate::new(
         ci,
+        c.colour,
         ConstraintBodies {
             index_a: ba.index,
             index_b: bb.index,
@@ -767,22 +783,33 @@ fn candidate(ci: u32, c: &Contact, solver_bodies: &[SolverBody]) -> Option<Candi
 }
 
 /// Updates one contact's manifold (recycled when its bodies barely moved); reads only the
-/// bodies and shapes, so contacts can be updated in parallel.
-fn narrow_phase(c: &mut Contact, bodies: &Arena<Body>, shapes: &Arena<ShapeRecord>, dt: f32) -> NarrowOutcome {
-    let (Some(ba), Some(bb)) = (bodies.at(c.body_a), bodies.at(c.body_b)) else {
+/// bodies' solver entries and the shapes, so contacts can be updated in parallel.
+fn narrow_phase(
+    c: &mut Contact,
+    bodies: &[SolverBody],
+    bounds: &[ShapeBounds],
+    shapes: &Arena<ShapeRecord>,
+    dt: f32,
+) -> NarrowOutcome {
+    let (Some(ba), Some(bb)) = (bodies.get(c.body_a as usize), bodies.get(c.body_b as usize)) else {
         return NarrowOutcome::Skipped;
     };
-    let active_a = ba.awake && ba.body_type != BodyType::Static;
-    let active_b = bb.awake && bb.body_type != BodyType::Static;
-    if !active_a && !active_b {
+    if !ba.active && !bb.active {
         return NarrowOutcome::Skipped;
     }
-    let (Some(sa), Some(sb)) = (
-        shapes.get(c.shape_a.index, c.shape_a.generation),
-        shapes.get(c.shape_b.index, c.shape_b.generation),
-    ) else {
+    let shape = |id: ShapeId| bounds.get(id.index as usize).filter(|s| s.generation == id.generation);
+    let (Some(sa), Some(sb)) = (shape(c.shape_a), shape(c.shape_b)) else {
         return NarrowOutcome::Skipped;
     };
+    #[cfg(debug_assertions)]
+    for (id, copy) in [(c.shape_a, sa), (c.shape_b, sb)] {
+        let s = shapes.get(id.index, id.generation);
+        debug_assert!(
+            s.is_some_and(|s| s.fat_aabb == copy.fat_aabb && s.aabb == copy.aabb && s.filter == copy.filter),
+            "shape bounds out of step with shape {}",
+            id.index
+        );
+    }
     if !sa.fat_aabb.overlaps(sb.fat_aabb) || !sa.filter.should_collide(&sb.filter) {
         return NarrowOutcome::Destroy;
     }
@@ -801,11 +828,7 @@ fn narrow_phase(c: &mut Contact, bodies: &Arena<Body>, shapes: &Arena<ShapeRecor
         };
     }
     // A pair found apart that cannot have closed the gap since: its manifold stays empty.
-    let (d, reach_a, reach_b) = (
-        bb.xf.p - ba.xf.p,
-        ba.max_extent + ba.local_center.length(),
-        bb.max_extent + bb.local_center.length(),
-    );
+    let (d, reach_a, reach_b) = (bb.xf.p - ba.xf.p, ba.reach, bb.reach);
     if c.still_apart(d, ba.xf.q, bb.xf.q, reach_a, reach_b, margin) {
         return NarrowOutcome::Updated {
             touching: false,
@@ -820,7 +843,10 @@ fn narrow_phase(c: &mut Contact, bodies: &Arena<Body>, shapes: &Arena<ShapeRecor
     // at most. Faster pairs are collided again (Box2D's fast bodies bypass recycling too).
     let slow = dt * rel <= SPECULATIVE_DISTANCE;
     let now = (slow && c.recycle(ba.xf, bb.xf, 2.0 * ba.max_extent.min(bb.max_extent)))
-        || c.update(&sa.geometry, ba.xf, &sb.geometry, bb.xf, margin);
+        || match (shapes.at(c.shape_a.index), shapes.at(c.shape_b.index)) {
+            (Some(sa), Some(sb)) => c.update(&sa.geometry, ba.xf, &sb.geometry, bb.xf, margin),
+            _ => false,
+        };
     if !now && c.far_bound > 0.0 {
         c.far = FarPoses {
             d,
