@@ -64,6 +64,8 @@ pub(crate) struct Candidate {
     fast: bool,
     /// The colour the contact had when last solved ([`NO_COLOUR`]: none), tried first.
     colour: u8,
+    /// A point is new this step (the warm-start estimate looks at the constraint).
+    fresh: bool,
     pub bodies: ConstraintBodies,
     pub input: ContactInput,
 }
@@ -74,6 +76,7 @@ impl Candidate {
             contact,
             fast: fast_first(&input),
             colour,
+            fresh: input.points[..(input.count as usize).min(2)].iter().any(|p| p.fresh),
             bodies,
             input,
         }
@@ -84,6 +87,7 @@ impl Candidate {
         contact: u32::MAX,
         fast: false,
         colour: NO_COLOUR,
+        fresh: false,
         bodies: ConstraintBodies {
             index_a: 0,
             index_b: 0,
@@ -165,7 +169,7 @@ pub(crate) struct ContactSolver {
     contact_of: Vec<u32>,
     contacts_ascend: bool,
     // Scratch reused every step.
-    /// Each candidate's colour (with the [`FAST`] flag) or [`OVERFLOW`].
+    /// Each candidate's colour (with the [`FAST`] and [`FRESH`] flags) or [`OVERFLOW`].
     colours: Vec<u8>,
     used: Vec<u32>,
     slots: Vec<Slot>,
@@ -213,7 +217,9 @@ const OVERFLOW: u8 = u8::MAX;
 
 /// Flag in a constraint's colour byte: it goes to the front of its colour ([`fast_first`]).
 const FAST: u8 = 0x40;
-const _: () = assert!(COLORS <= FAST as usize);
+/// Flag in a constraint's colour byte: it has a point new this step ([`Candidate`]).
+const FRESH: u8 = 0x20;
+const _: () = assert!(COLORS <= FRESH as usize);
 
 /// The colours' runs of `wide` as separate mutable slices (`ranges` ascending, disjoint).
 fn split_ranges<'a, T>(wide: &'a mut [T], ranges: &[(u32, u32)]) -> Vec<&'a mut [T]> {
@@ -281,10 +287,10 @@ impl ContactSolver {
             if b.inv_mass_a > 0.0 && b.inv_mass_b > 0.0 {
                 // The light body, and the direction from it to the heavy one (the normal
                 // points from A to B).
-                let (ratio, body, heavy, to_heavy) = if b.inv_mass_a > b.inv_mass_b {
-                    (b.inv_mass_a / b.inv_mass_b, b.index_a, b.index_b, cand.input.normal)
+                let (ratio, body, heavy, a_is_light) = if b.inv_mass_a > b.inv_mass_b {
+                    (b.inv_mass_a / b.inv_mass_b, b.index_a, b.index_b, true)
                 } else {
-                    (b.inv_mass_b / b.inv_mass_a, b.index_b, b.index_a, -cand.input.normal)
+                    (b.inv_mass_b / b.inv_mass_a, b.index_b, b.index_a, false)
                 };
                 // Only where the heavy body rests on the light one: it lies above it against
                 // gravity (a heavy container holding light bodies, Box2D's tumbler drum at
@@ -292,11 +298,16 @@ impl ContactSolver {
                 // has no joint (a motor may press it on the light body with any torque:
                 // Box2D's spinner rotor, squeezing bodies against the wall with unbounded
                 // torque, made the extra sweeps pile up impulses without bound until the
-                // states overflowed).
-                let carries = self.up == Vec2::ZERO || to_heavy.dot(self.up) > MIN_CARRY_COSINE;
-                let free = sims.get(heavy as usize).is_some_and(|s| !s.jointed);
-                if ratio > MASS_RATIO_GROUP && carries && free {
-                    light.push((body, (ratio.ceil() as u32).min(MAX_LOCAL_SWEEPS)));
+                // states overflowed). The normal (in the candidate's second cache line) is
+                // read only for such a pair.
+                if ratio > MASS_RATIO_GROUP {
+                    let n = cand.input.normal;
+                    let to_heavy = if a_is_light { n } else { -n };
+                    let carries = self.up == Vec2::ZERO || to_heavy.dot(self.up) > MIN_CARRY_COSINE;
+                    let free = sims.get(heavy as usize).is_some_and(|s| !s.jointed);
+                    if carries && free {
+                        light.push((body, (ratio.ceil() as u32).min(MAX_LOCAL_SWEEPS)));
+                    }
                 }
             }
             let (da, db) = (
@@ -334,7 +345,8 @@ impl ContactSolver {
                     counts[k] += 1;
                     let fast = cand.fast;
                     fast_counts[k] += fast as u32;
-                    self.colours.push(k as u8 | if fast { FAST } else { 0 });
+                    self.colours
+                        .push(k as u8 | if fast { FAST } else { 0 } | if cand.fresh { FRESH } else { 0 });
                 }
                 None => self.colours.push(OVERFLOW),
             }
@@ -382,7 +394,7 @@ impl ContactSolver {
                 self.overflow.push(cc);
                 Slot::Overflow(self.overflow.len() as u32 - 1)
             } else {
-                let k = (colour & !FAST) as usize;
+                let k = (colour & !(FAST | FRESH)) as usize;
                 let next = if colour & FAST != 0 {
                     &mut next[k]
                 } else {
@@ -393,10 +405,14 @@ impl ContactSolver {
                 let (group, lane) = (at / LANES as u32, at % LANES as u32);
                 self.lane_candidates[group as usize][lane as usize] = i as u32;
                 self.layout[at as usize] = self.contact_of[i];
-                Slot::Wide {
+                let slot = Slot::Wide {
                     group,
                     lane: lane as u8,
+                };
+                if colour & FRESH != 0 {
+                    self.fresh.push(slot);
                 }
+                slot
             };
             self.slots.push(slot);
         }
@@ -425,16 +441,6 @@ impl ContactSolver {
                 contact_wide::build_group(h, w, cold, lanes, up, ctx, states);
             },
         );
-        for (g, cold) in self.cold.iter().enumerate() {
-            for l in 0..LANES {
-                if cold.fresh[0][l] || cold.fresh[1][l] {
-                    self.fresh.push(Slot::Wide {
-                        group: g as u32,
-                        lane: l as u8,
-                    });
-                }
-            }
-        }
         self.layout_fresh = true;
         self.loaded = any_load(sims);
         if self.loaded {

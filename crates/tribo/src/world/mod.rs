@@ -159,21 +159,6 @@ impl ShapeBounds {
 
 const _: () = assert!(core::mem::size_of::<ShapeBounds>() == 64);
 
-/// [`World::sync_shape_bounds`] on the two fields it reads and writes.
-fn sync_bounds(shapes: &Arena<ShapeRecord>, bounds: &mut Vec<ShapeBounds>, index: u32) {
-    let copy = shapes.at(index).map_or(ShapeBounds::NONE, |s| ShapeBounds {
-        fat_aabb: s.fat_aabb,
-        aabb: s.aabb,
-        filter: s.filter,
-        generation: shapes.generation(index),
-    });
-    let i = index as usize;
-    if bounds.len() <= i {
-        bounds.resize(i + 1, ShapeBounds::NONE);
-    }
-    bounds[i] = copy;
-}
-
 /// A 2D physics world.
 pub struct World {
     pub(crate) def: WorldDef,
@@ -884,7 +869,17 @@ impl World {
     /// Copies a shape slot's boxes, filter and generation into [`World::shape_bounds`]
     /// (after every write of them).
     pub(crate) fn sync_shape_bounds(&mut self, index: u32) {
-        sync_bounds(&self.shapes, &mut self.shape_bounds, index);
+        let copy = self.shapes.at(index).map_or(ShapeBounds::NONE, |s| ShapeBounds {
+            fat_aabb: s.fat_aabb,
+            aabb: s.aabb,
+            filter: s.filter,
+            generation: self.shapes.generation(index),
+        });
+        let i = index as usize;
+        if self.shape_bounds.len() <= i {
+            self.shape_bounds.resize(i + 1, ShapeBounds::NONE);
+        }
+        self.shape_bounds[i] = copy;
     }
 
     /// Updates the fat boxes of a body's shapes after its pose changed.
@@ -926,7 +921,9 @@ impl World {
                 let (tree, proxy) = (s.tree, s.proxy);
                 self.broad_phase.move_proxy(tree, proxy, fat, sid.index);
             }
-            sync_bounds(&self.shapes, &mut self.shape_bounds, sid.index);
+            if let Some(bounds) = self.shape_bounds.get_mut(sid.index as usize) {
+                (bounds.aabb, bounds.fat_aabb) = (s.aabb, s.fat_aabb);
+            }
         }
         None
     }
