@@ -88,7 +88,8 @@ impl World {
         &self.events
     }
 
-    /// Every touching contact, in contact-record order (deterministic).
+    /// Every touching contact, in contact-record order (deterministic; the order may change
+    /// from one step to the next: the world renumbers its contacts in the solver's order).
     pub fn contacts(&self) -> impl Iterator<Item = ContactInfo> + '_ {
         self.contacts
             .iter()
