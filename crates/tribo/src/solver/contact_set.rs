@@ -2,10 +2,11 @@
 //! wide packing, overflow, mass-ratio groups, and the [`ConstraintSet`] stages over them.
 //!
 //! Build (once per step, from the touching contacts in contact order):
-//! 1. colour every constraint (greedy first fit on per-body colour masks: moving pairs take
-//!    the lowest free colour, pairs with a static or kinematic side the highest, so each
-//!    pass solves them last, as Box2D v3's `constraint_graph.c` does); no free colour →
-//!    overflow;
+//! 1. colour every constraint: the colour it had last step while that is still free (so a
+//!    pile keeps its layout from step to step, as Box2D v3's persistent graph colours do),
+//!    else greedy first fit on per-body colour masks: moving pairs take the lowest free
+//!    colour, pairs with a static or kinematic side the highest, so each pass solves them
+//!    last, as Box2D v3's `constraint_graph.c` does; no free colour → overflow;
 //! 2. lay the colours out as runs of groups of four lanes ([`WideHead`] + [`WideContact`]
 //!    + [`WideCold`]); inside a colour, face contacts whose two points both carried load
 //!    go first (they will most likely take the 2×2 block's fast path together);
@@ -316,8 +317,8 @@ impl ContactSolver {
             );
             let busy = (if da { self.used[b.index_a as usize] } else { 0 })
                 | (if db { self.used[b.index_b as usize] } else { 0 });
-            // The colour of the last step when it is still free (a pile keeps its layout,
-            // see `layout_order`), else the lowest free colour below DYNAMIC_COLORS, or the
+            // The colour of the last step when it is still free (a pile keeps its layout:
+            // `World::reorder_contacts`), else the lowest free colour below DYNAMIC_COLORS, or the
             // highest free one from 1 up (bit scans of the free colours).
             let open = if da && db {
                 DYNAMIC_COLOR_BITS
