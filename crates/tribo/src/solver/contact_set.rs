@@ -29,9 +29,9 @@
 //! [`team_loop`]: ContactSolver::team_loop
 
 use super::contact_solver::{
-    bounces, build_constraint, end_substep_one, estimate, has_fresh_point, is_new_resting, record_approach,
-    restitution_one, solve_one, store_impulses, warm_start_one, ConstraintBodies, ContactConstraint, ContactInput,
-    StepSoftness, MASS_RATIO_GROUP, MAX_ESTIMATE_SWEEPS, MAX_LOCAL_SWEEPS, ONGOING_ESTIMATE_SWEEPS,
+    bounces, build_constraint, end_substep_one, estimate, is_new_resting, record_approach, restitution_one, solve_one,
+    store_impulses, warm_start_one, ConstraintBodies, ContactConstraint, ContactInput, StepSoftness, MASS_RATIO_GROUP,
+    MAX_ESTIMATE_SWEEPS, MAX_LOCAL_SWEEPS, ONGOING_ESTIMATE_SWEEPS,
 };
 use super::contact_wide::{self, StoredContact, WideCold, WideContact, WideHead, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
@@ -157,10 +157,6 @@ pub(crate) struct ContactSolver {
     ranges: Vec<(u32, u32)>,
     /// The colour of each group (stored into its contacts, tried first next step).
     group_colour: Vec<u8>,
-    /// The contact in each lane (group by group; `u32::MAX`: empty lane).
-    layout: Vec<u32>,
-    /// `layout` is the last step's and not yet taken ([`ContactSolver::take_layout`]).
-    layout_fresh: bool,
     /// Candidate index of each lane of each group (`u32::MAX`: empty lane).
     lane_candidates: Vec<[u32; LANES]>,
     /// What each lane stores into its contact (the store's first half, in group order).
@@ -381,15 +377,13 @@ impl ContactSolver {
         self.slots.clear();
         self.lane_candidates.clear();
         self.lane_candidates.resize(groups as usize, [u32::MAX; LANES]);
-        self.layout.clear();
-        self.layout.resize(groups as usize * LANES, u32::MAX);
         // Reads only the colour bytes (and the rare overflow candidates), not the candidates.
         for (i, &colour) in self.colours.iter().enumerate() {
             let slot = if colour == OVERFLOW {
                 let Some(cand) = candidates.get(i) else { continue };
                 let b = &cand.bodies;
                 let cc = build_constraint(cand.contact, &cand.input, b, self.up, &soft, ctx, states);
-                if has_fresh_point(&cc) {
+                if cand.fresh {
                     self.fresh.push(Slot::Overflow(self.overflow.len() as u32));
                 }
                 self.overflow.push(cc);
@@ -405,7 +399,6 @@ impl ContactSolver {
                 *next += 1;
                 let (group, lane) = (at / LANES as u32, at % LANES as u32);
                 self.lane_candidates[group as usize][lane as usize] = i as u32;
-                self.layout[at as usize] = self.contact_of[i];
                 let slot = Slot::Wide {
                     group,
                     lane: lane as u8,
@@ -442,7 +435,6 @@ impl ContactSolver {
                 contact_wide::build_group(h, w, cold, lanes, up, ctx, states);
             },
         );
-        self.layout_fresh = true;
         self.loaded = any_load(sims);
         if self.loaded {
             self.build_groups(light, candidates);
@@ -454,13 +446,17 @@ impl ContactSolver {
     /// The contacts solved in the last step in the order the solver laid them out (group
     /// by group, lane by lane, then the overflow list), into `out`; returns how many of
     /// them do not follow the one before in contact order (few: the contacts already lie
-    /// in the layout's order). Nothing once taken: the contacts may have been renumbered.
-    pub fn take_layout(&mut self, out: &mut Vec<u32>) -> usize {
+    /// in the layout's order). Read only when a renumbering may follow, not every step.
+    /// Any list is safe to renumber by (each live contact is placed once); a stale one
+    /// only orders them less well.
+    pub fn solved_order(&self, out: &mut Vec<u32>) -> usize {
         out.clear();
-        if !core::mem::take(&mut self.layout_fresh) {
-            return 0;
-        }
-        let lanes = self.layout.iter().copied().filter(|&contact| contact != u32::MAX);
+        let contact_of = &self.contact_of;
+        let lanes = self
+            .lane_candidates
+            .iter()
+            .flatten()
+            .filter_map(|&cand| contact_of.get(cand as usize).copied());
         let mut breaks = 0;
         let mut last = u32::MAX;
         for contact in lanes.chain(self.overflow.iter().map(|oc| oc.contact)) {

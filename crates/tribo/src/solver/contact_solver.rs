@@ -375,11 +375,6 @@ impl StepSoftness {
     }
 }
 
-/// Whether any point of the constraint is new this step.
-pub(crate) fn has_fresh_point(cc: &ContactConstraint) -> bool {
-    cc.points[..cc.count].iter().any(|p| p.fresh)
-}
-
 /// Records each point's normal velocity under `states` (the approach speed of new points).
 pub(crate) fn record_approach<S: StateRead>(cc: &mut ContactConstraint, states: &[S]) {
     let (a, b) = load(states, cc.index_a, cc.index_b);

@@ -360,12 +360,11 @@ pub(crate) struct BodySim {
 #[derive(Clone, Copy, Debug, Default)]
 #[repr(C, align(64))]
 pub(crate) struct SolverBody {
-    /// Index of the body's state in the solver arrays (0 = none: static or asleep).
+    /// Index of the body's state in the solver arrays (0 = none: static or asleep; a
+    /// body with a state is active: its contacts are updated this step).
     pub index: u32,
     /// Awake and dynamic: its contacts are solved this step.
     pub awake_dynamic: bool,
-    /// Awake and not static: its contacts are updated this step.
-    pub active: bool,
     /// Inverse mass [1/kg] and inverse rotational inertia [1/(kg·m²)] as the solver sees
     /// them (0 for bodies without a state).
     pub inv_mass: f32,

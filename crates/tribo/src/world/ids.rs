@@ -162,11 +162,6 @@ impl<T> Arena<T> {
             .enumerate()
             .filter_map(|(i, s)| s.value.as_ref().map(|v| (i as u32, v)))
     }
-
-    /// Live values, mutable, in index order.
-    pub fn values_mut(&mut self) -> impl Iterator<Item = &mut T> {
-        self.slots.iter_mut().filter_map(|s| s.value.as_mut())
-    }
 }
 
 #[cfg(test)]

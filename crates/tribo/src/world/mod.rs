@@ -159,6 +159,14 @@ impl ShapeBounds {
 
 const _: () = assert!(core::mem::size_of::<ShapeBounds>() == 64);
 
+/// After a shape's boxes changed: copies them into its [`ShapeBounds`] (filter and
+/// generation unchanged; [`World::sync_shape_bounds`] copies everything).
+pub(crate) fn copy_boxes(bounds: &mut [ShapeBounds], index: u32, s: &ShapeRecord) {
+    if let Some(b) = bounds.get_mut(index as usize) {
+        (b.aabb, b.fat_aabb) = (s.aabb, s.fat_aabb);
+    }
+}
+
 /// A 2D physics world.
 pub struct World {
     pub(crate) def: WorldDef,
@@ -921,9 +929,7 @@ impl World {
                 let (tree, proxy) = (s.tree, s.proxy);
                 self.broad_phase.move_proxy(tree, proxy, fat, sid.index);
             }
-            if let Some(bounds) = self.shape_bounds.get_mut(sid.index as usize) {
-                (bounds.aabb, bounds.fat_aabb) = (s.aabb, s.fat_aabb);
-            }
+            copy_boxes(&mut self.shape_bounds, sid.index, s);
         }
         None
     }
@@ -1042,7 +1048,7 @@ impl World {
             return;
         }
         let mut order = core::mem::take(&mut self.scratch_u32);
-        let breaks = self.contact_solver.take_layout(&mut order);
+        let breaks = self.contact_solver.solved_order(&mut order);
         if order.len() < REORDER_MIN_CONTACTS || REORDER_BREAKS * breaks < order.len() {
             self.scratch_u32 = order;
             return;
@@ -1070,9 +1076,8 @@ impl World {
         // Every value is replaced independently of the others: the map's order cannot
         // reach the result.
         self.broad_phase.pairs.values_mut().for_each(renumber);
-        for b in self.bodies.values_mut() {
-            b.contacts.iter_mut().for_each(renumber);
-        }
+        self.bodies
+            .for_each_live_mut(false, usize::MAX, |_, b| b.contacts.iter_mut().for_each(renumber));
         self.scratch_u32 = order;
     }
 

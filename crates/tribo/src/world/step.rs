@@ -21,7 +21,7 @@ use crate::solver::{
     for_each_mut, for_each_mut3, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints, StepContext,
 };
 use crate::world::Arena;
-use crate::world::{box_velocity, next_box};
+use crate::world::{box_velocity, copy_boxes, next_box};
 use crate::world::{BodyId, ShapeId};
 
 impl World {
@@ -469,11 +469,9 @@ impl World {
             let (Some(b), Some(sb)) = (self.bodies.at(bi), self.solver_bodies.get_mut(bi as usize)) else {
                 continue;
             };
-            let active = b.awake && b.body_type != BodyType::Static;
             *sb = SolverBody {
                 index: 0,
                 awake_dynamic: false,
-                active,
                 inv_mass: 0.0,
                 inv_i: 0.0,
                 center: b.center,
@@ -483,7 +481,7 @@ impl World {
                 max_extent: b.max_extent,
                 reach: b.max_extent + b.local_center.length(),
             };
-            if !active {
+            if !b.awake || b.body_type == BodyType::Static {
                 continue;
             }
             sb.index = self.states.len() as u32;
@@ -642,9 +640,7 @@ impl World {
                 (Some(aabb), Some(sid)) => {
                     if let Some(s) = self.shapes.get_mut(sid.index, sid.generation) {
                         s.aabb = aabb;
-                        if let Some(bounds) = self.shape_bounds.get_mut(sid.index as usize) {
-                            bounds.aabb = aabb;
-                        }
+                        copy_boxes(&mut self.shape_bounds, sid.index, s);
                     }
                 }
                 _ => self.refresh_body_proxies(bi, dt),
@@ -794,7 +790,7 @@ fn narrow_phase(
     let (Some(ba), Some(bb)) = (bodies.get(c.body_a as usize), bodies.get(c.body_b as usize)) else {
         return NarrowOutcome::Skipped;
     };
-    if !ba.active && !bb.active {
+    if ba.index == 0 && bb.index == 0 {
         return NarrowOutcome::Skipped;
     }
     let shape = |id: ShapeId| bounds.get(id.index as usize).filter(|s| s.generation == id.generation);
