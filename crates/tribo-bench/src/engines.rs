@@ -300,8 +300,8 @@ mod tribo_sim {
 mod box2d_sim {
     use super::*;
     use boxdd::{
-        shapes, BodyBuilder, BodyId, BodyType, ConstraintTuning, Filter, Foundation, MotionLocks, Position, Profile,
-        RevoluteJointDef, ShapeDef, SurfaceMaterial, Transform, Vec2, WorkerCount, World, WorldBuilder,
+        shapes, BodyBuilder, BodyId, BodyType, ChainDef, ConstraintTuning, Filter, Foundation, MotionLocks, Position,
+        Profile, RevoluteJointDef, ShapeDef, SurfaceMaterial, Transform, Vec2, WorkerCount, World, WorldBuilder,
     };
 
     pub struct Box2dSim {
@@ -429,6 +429,30 @@ mod box2d_sim {
                             let p1 = shape_field(s.point1, "point1", s)?;
                             let p2 = shape_field(s.point2, "point2", s)?;
                             body.create_segment(&def, &shapes::segment(v(p1), v(p2))?)?;
+                        }
+                        "chain" => {
+                            let pts = s.points.as_ref().ok_or("a chain needs \"points\"")?;
+                            let closed = s.closed.unwrap_or(false);
+                            let mut all: Vec<[f32; 2]> = pts.clone();
+                            if !closed && pts.len() >= 2 {
+                                // Box2D uses an open chain's first and last points as ghost
+                                // vertices only; Tribo's free ends are right-angled corners,
+                                // so the ghosts go behind the end pieces.
+                                let behind = |a: [f32; 2], b: [f32; 2], at: [f32; 2]| {
+                                    // −right_perp(b − a) = (−(b−a).y, (b−a).x)
+                                    [at[0] - (b[1] - a[1]), at[1] + (b[0] - a[0])]
+                                };
+                                let n = pts.len();
+                                all.insert(0, behind(pts[0], pts[1], pts[0]));
+                                all.push(behind(pts[n - 2], pts[n - 1], pts[n - 1]));
+                            }
+                            let chain = ChainDef::builder()
+                                .points(all.iter().map(|&p| v(p)))
+                                .is_loop(closed)
+                                .single_material(&material)
+                                .filter(filter)
+                                .build()?;
+                            body.create_chain(&chain)?;
                         }
                         other => return Err(format!("unknown shape type {other}").into()),
                     }
@@ -698,6 +722,25 @@ mod rapier_sim {
                         v(shape_field(s.point1, "point1", s)?),
                         v(shape_field(s.point2, "point2", s)?),
                     ),
+                    // Rapier's one-sided polyline: same winding rule as a Box2D or Tribo chain
+                    // (clockwise: the outside is solid), without ghost-vertex smoothing.
+                    "chain" => {
+                        let pts: Vec<Vector> = s
+                            .points
+                            .as_ref()
+                            .ok_or("a chain needs \"points\"")?
+                            .iter()
+                            .map(|&p| v(p))
+                            .collect();
+                        let n = pts.len() as u32;
+                        let pieces = if s.closed.unwrap_or(false) {
+                            n
+                        } else {
+                            n.saturating_sub(1)
+                        };
+                        let indices = (0..pieces).map(|i| [i, (i + 1) % n]).collect();
+                        ColliderBuilder::oriented_polyline(pts, Some(indices))
+                    }
                     other => return Err(format!("unknown shape type {other}").into()),
                 }
                 .collision_groups(groups(s)?)

@@ -31,12 +31,11 @@ pub enum CheckKind {
         /// Largest centre distance of two jointed bodies [m].
         max_link: f32,
     },
-    /// Spinner: no body out of the ring (centre beyond the wall's outer face) and the rotor
-    /// (the body named "rotor") turning at its motor speed within 1 %; bodies whose centre
-    /// is `radius` or more from the ring centre (pressed into the wall deeper than the 0.5 m
-    /// the rotor's tip, reaching 0.2 m past the ring, can explain) are counted and shown.
+    /// Spinner: no body out of the ring (centre `radius` or more from the ring's centre: a
+    /// body whose centre has crossed the one-sided chain is on its way out of the world) and
+    /// the rotor (the body named "rotor") turning at its motor speed within 1 %.
     Spinner {
-        /// Inner radius of the ring [m].
+        /// The ring's radius plus a margin [m].
         radius: f32,
     },
     /// Every box's centre must stay within the washer's rim (`radius` of the ring centre,
@@ -160,13 +159,15 @@ pub fn scenes() -> Vec<BenchScene> {
             CheckKind::JointGrid { max_link: 1.25 },
         ),
         BenchScene {
-            note: "the ring is 360 quads 2.5 m thick in all three engines (Box2D's scene: a one-sided chain loop)",
+            note: "the ring is a one-sided chain loop of 360 pieces: Box2D's chain, Tribo's chain (ghost-vertex \
+                   smoothing as Box2D), Rapier's oriented polyline (one-sided, no smoothing)",
             ..BenchScene::new(
                 "spinner",
                 tribo_scenes::scenes::spinner,
                 CheckKind::Spinner {
-                    // The rotor's tip reaches 0.2 m past the ring at its lowest point, so a
-                    // body it sweeps by may be pressed that far into the wall for a moment.
+                    // A body held by the ring has its centre inside it; 0.5 m of margin for
+                    // the chord of a 1° piece and a body pressed there by the rotor's tip,
+                    // which reaches 0.2 m past the ring at its lowest point.
                     radius: tribo_scenes::scenes::SPINNER_RADIUS + 0.5,
                 },
             )

@@ -35,6 +35,9 @@ pub enum DrawKind {
         p1: [f32; 2],
         /// Second end [m].
         p2: [f32; 2],
+        /// For a one-sided chain piece: the unit direction [world axes] of its solid side
+        /// (where the ground ticks go); `None` for a two-sided segment (ticks below).
+        back: Option<[f32; 2]>,
     },
 }
 

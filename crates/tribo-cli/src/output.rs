@@ -102,7 +102,8 @@ const PALETTE: [[u8; 3]; 8] = [
     [196, 160, 140], // tan
 ];
 
-/// Fill colours of a scene's shapes by material, palette indices shared through `keys`.
+/// Fill colours of a scene's engine shapes (a chain's pieces each) by material, palette
+/// indices shared through `keys`.
 fn shape_colors(scene: &SceneFile, keys: &mut HashMap<String, usize>) -> Vec<Vec<[u8; 3]>> {
     scene
         .bodies
@@ -110,7 +111,7 @@ fn shape_colors(scene: &SceneFile, keys: &mut HashMap<String, usize>) -> Vec<Vec
         .map(|b| {
             b.shapes
                 .iter()
-                .map(|s| {
+                .flat_map(|s| {
                     let key = match &s.material {
                         None => "default".to_string(),
                         Some(MaterialRef::Named(n)) => n.clone(),
@@ -118,7 +119,12 @@ fn shape_colors(scene: &SceneFile, keys: &mut HashMap<String, usize>) -> Vec<Vec
                     };
                     let n = keys.len();
                     let idx = *keys.entry(key).or_insert(n);
-                    PALETTE[idx % PALETTE.len()]
+                    let pieces = match (s.kind.as_str(), &s.points) {
+                        ("chain", Some(p)) if s.closed == Some(true) => p.len(),
+                        ("chain", Some(p)) => p.len().saturating_sub(1),
+                        _ => 1,
+                    };
+                    std::iter::repeat_n(PALETTE[idx % PALETTE.len()], pieces)
                 })
                 .collect()
         })
@@ -259,7 +265,16 @@ impl Simulation {
                         Shape::Segment(s) => DrawKind::Segment {
                             p1: p(s.point1),
                             p2: p(s.point2),
+                            back: None,
                         },
+                        Shape::ChainSegment(c) => {
+                            let back = xf.q.rotate(-c.normal());
+                            DrawKind::Segment {
+                                p1: p(c.segment.point1),
+                                p2: p(c.segment.point2),
+                                back: Some([back.x, back.y]),
+                            }
+                        }
                     };
                     let fill = colors.and_then(|row| row.get(j)).copied().unwrap_or(PALETTE[0]);
                     frame.shapes.push(DrawShape {

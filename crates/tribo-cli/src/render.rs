@@ -158,7 +158,7 @@ impl Bounds {
                 self.add_disc(*p1, *radius);
                 self.add_disc(*p2, *radius);
             }
-            DrawKind::Segment { p1, p2 } => {
+            DrawKind::Segment { p1, p2, .. } => {
                 self.add_disc(*p1, 0.0);
                 self.add_disc(*p2, 0.0);
             }
@@ -754,7 +754,7 @@ impl<'a> Scene<'a> {
                     });
                 }
             }
-            DrawKind::Segment { p1, p2 } => {
+            DrawKind::Segment { p1, p2, back } => {
                 if !finite2(*p1) || !finite2(*p2) {
                     return;
                 }
@@ -763,7 +763,8 @@ impl<'a> Scene<'a> {
                     return;
                 };
                 if shape.is_static {
-                    self.ground_ticks(a, b);
+                    // Screen y points down: a world direction (x, y) is (x, −y) on screen.
+                    self.ground_ticks(a, b, back.map(|d| [d[0], -d[1]]));
                 }
                 let color = if shape.is_static { STATIC_OUTLINE } else { OUTLINE };
                 self.prims.push(Prim::Line {
@@ -776,8 +777,9 @@ impl<'a> Scene<'a> {
         }
     }
 
-    /// Short slanted ticks under a ground segment (engineering ground symbol).
-    fn ground_ticks(&mut self, a: [f32; 2], b: [f32; 2]) {
+    /// Short slanted ticks under a ground segment (engineering ground symbol), or on the
+    /// side `back` [screen direction] of a one-sided one.
+    fn ground_ticks(&mut self, a: [f32; 2], b: [f32; 2], back: Option<[f32; 2]>) {
         let d = [b[0] - a[0], b[1] - a[1]];
         let len = d[0].hypot(d[1]);
         if len < 2.0 {
@@ -786,7 +788,11 @@ impl<'a> Scene<'a> {
         let u = [d[0] / len, d[1] / len];
         // Screen normal pointing up (negative y); ticks go to the other side.
         let mut n = [u[1], -u[0]];
-        if n[1] > 0.0 || (n[1] == 0.0 && n[0] < 0.0) {
+        let flip = match back {
+            Some(k) => n[0] * k[0] + n[1] * k[1] > 0.0,
+            None => n[1] > 0.0 || (n[1] == 0.0 && n[0] < 0.0),
+        };
+        if flip {
             n = [-n[0], -n[1]];
         }
         let spacing = 9.0;
@@ -1787,6 +1793,7 @@ mod tests {
                     DrawKind::Segment {
                         p1: [-3.0, 1.2],
                         p2: [-1.2, 0.0],
+                        back: None,
                     },
                     [90, 90, 90],
                     true,
@@ -2012,6 +2019,7 @@ mod tests {
             DrawKind::Segment {
                 p1: [3.0, 3.0],
                 p2: [3.0, 3.0],
+                back: None,
             },
             [0, 0, 0],
             false,

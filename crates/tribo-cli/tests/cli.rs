@@ -255,6 +255,31 @@ fn malformed_scenes_are_rejected_with_their_place() {
             "bodies[1].shapes[0].type",
         ),
         (
+            "chain with a repeated point",
+            body(r#"{"type": "chain", "points": [[0, 0], [1, 0], [1, 0], [2, 1]]}"#),
+            "bodies[1].shapes[0].points[2]",
+        ),
+        (
+            "chain loop closing on its first point",
+            body(r#"{"type": "chain", "loop": true, "points": [[0, 0], [1, 0], [1, 1], [0, 0]]}"#),
+            "bodies[1].shapes[0].points[0]",
+        ),
+        (
+            "chain loop of two points",
+            body(r#"{"type": "chain", "loop": true, "points": [[0, 0], [1, 0]]}"#),
+            "bodies[1].shapes[0].points",
+        ),
+        (
+            "chain without points",
+            body(r#"{"type": "chain", "loop": true}"#),
+            "bodies[1].shapes[0].points",
+        ),
+        (
+            "chain loop flag not a boolean",
+            body(r#"{"type": "chain", "loop": 1, "points": [[0, 0], [1, 0]]}"#),
+            "bodies[1].shapes[0].loop",
+        ),
+        (
             "truncated JSON",
             r#"{"bodies": [{"name": "b", "type": "dyn"#.into(),
             "line 1",

@@ -10,8 +10,8 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt;
 use tribo::{
-    BodyDef, BodyId, BodyType, Capsule, Circle, CombineRule, Filter, Material, Polygon, RevoluteJointDef, Segment,
-    Shape, ShapeDef, Vec2, World, WorldDef,
+    BodyDef, BodyId, BodyType, Capsule, ChainSegment, Circle, CombineRule, Filter, Material, Polygon, RevoluteJointDef,
+    Segment, Shape, ShapeDef, Vec2, World, WorldDef,
 };
 
 /// A scene file.
@@ -275,12 +275,12 @@ fn default_one() -> f32 {
 
 /// A shape as written in a scene file. `type` selects which fields apply:
 /// circle {radius, center}; box {half_extents, center, angle}; polygon {vertices, radius};
-/// capsule {center1, center2, radius}; segment {point1, point2}. Coordinates in the body
-/// frame [m].
+/// capsule {center1, center2, radius}; segment {point1, point2}; chain {points, loop}.
+/// Coordinates in the body frame [m].
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShapeSpec {
-    /// "circle", "box", "polygon", "capsule" or "segment".
+    /// "circle", "box", "polygon", "capsule", "segment" or "chain".
     #[serde(rename = "type")]
     pub kind: String,
     /// Circle/capsule radius, or polygon rounding radius [m].
@@ -310,6 +310,13 @@ pub struct ShapeSpec {
     /// Segment end [m].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub point2: Option<[f32; 2]>,
+    /// Chain points [m], in order; each piece collides on its right side (wind a loop
+    /// clockwise to keep shapes inside it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<Vec<[f32; 2]>>,
+    /// Whether a chain closes into a loop (last point joined to the first). Default false.
+    #[serde(default, rename = "loop", skip_serializing_if = "Option::is_none")]
+    pub closed: Option<bool>,
     /// Material: a name from `materials` or an inline object. Default: the default material.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<MaterialRef>,
@@ -532,7 +539,7 @@ pub fn parse(text: &str) -> Result<SceneFile, SceneError> {
         }
     })?;
     scene.validate().map_err(|(path, message)| {
-        let (line, column) = locate_path(text, &path).unwrap_or((0, 0));
+        let (line, column) = locate_nearest(text, &path).unwrap_or((0, 0));
         SceneError {
             path,
             line,
@@ -541,6 +548,19 @@ pub fn parse(text: &str) -> Result<SceneFile, SceneError> {
         }
     })?;
     Ok(scene)
+}
+
+/// The line:column of `path` in `text`, or of the closest enclosing value that is there (a
+/// missing field's error names the field; its object is where to look).
+fn locate_nearest(text: &str, path: &str) -> Option<(usize, usize)> {
+    let mut p = path;
+    loop {
+        if let Some(at) = locate_path(text, p) {
+            return Some(at);
+        }
+        let cut = p.rfind(['.', '['])?;
+        p = &p[..cut];
+    }
 }
 
 /// serde_path_to_error writes `.` for the root and `?` for unknown positions.
@@ -597,7 +617,7 @@ impl SceneFile {
 
     /// [`SceneFile::validate`], keeping the engine shape of every shape (by body, then
     /// shape) so that building does not make each one (polygon hulls included) twice.
-    fn checked_geometries(&self) -> Result<Vec<Vec<Shape>>, Invalid> {
+    fn checked_geometries(&self) -> Result<Vec<Vec<Vec<Shape>>>, Invalid> {
         finite2("gravity", self.gravity)?;
         finite("dt", self.dt)?;
         if self.dt <= 0.0 || self.dt > 1.0 {
@@ -722,18 +742,21 @@ impl SceneFile {
         Ok(())
     }
 
-    /// The engine shape of a shape spec, with errors at `path`.
-    pub fn shape_geometry(&self, path: &str, s: &ShapeSpec) -> Result<Shape, Invalid> {
+    /// The engine shapes of a shape spec (one, or a chain's pieces), with errors at `path`.
+    pub fn shape_geometry(&self, path: &str, s: &ShapeSpec) -> Result<Vec<Shape>, Invalid> {
         let allowed: &[&str] = match s.kind.as_str() {
             "circle" => &["radius", "center"],
             "box" => &["half_extents", "center", "angle"],
             "polygon" => &["vertices", "radius"],
             "capsule" => &["center1", "center2", "radius"],
             "segment" => &["point1", "point2"],
+            "chain" => &["points", "loop"],
             other => {
                 return Err((
                     format!("{path}.type"),
-                    format!("unknown shape type \"{other}\" (expected circle, box, polygon, capsule or segment)"),
+                    format!(
+                        "unknown shape type \"{other}\" (expected circle, box, polygon, capsule, segment or chain)"
+                    ),
                 ))
             }
         };
@@ -747,6 +770,8 @@ impl SceneFile {
             ("center2", s.center2.is_some()),
             ("point1", s.point1.is_some()),
             ("point2", s.point2.is_some()),
+            ("points", s.points.is_some()),
+            ("loop", s.closed.is_some()),
         ];
         for (field, is) in present {
             if is && !allowed.contains(&field) {
@@ -790,13 +815,38 @@ impl SceneFile {
                 let r = s.radius.ok_or_else(|| need("radius"))?;
                 Shape::Capsule(Capsule::new(v(c1), v(c2), r).map_err(|e| geo("center2", e))?)
             }
+            "chain" => {
+                let pts = s.points.as_ref().ok_or_else(|| need("points"))?;
+                for (k, &p) in pts.iter().enumerate() {
+                    finite2(&format!("{path}.points[{k}]"), p)?;
+                }
+                let closed = s.closed.unwrap_or(false);
+                let pts: Vec<Vec2> = pts.iter().map(|&p| v(p)).collect();
+                // Name the point that ends a too short piece.
+                let n = pts.len();
+                let pieces = if closed { n } else { n.saturating_sub(1) };
+                if let Some(k) =
+                    (0..pieces).find(|&k| !((pts[(k + 1) % n] - pts[k]).length() >= tribo::geometry::LINEAR_SLOP))
+                {
+                    return Err((
+                        format!("{path}.points[{}]", (k + 1) % n),
+                        format!(
+                            "chain point {} lies within {} m of point {k}: pieces must be at least that long",
+                            (k + 1) % n,
+                            tribo::geometry::LINEAR_SLOP
+                        ),
+                    ));
+                }
+                let pieces = ChainSegment::chain(&pts, closed).map_err(|e| geo("points", e))?;
+                return Ok(pieces.into_iter().map(Shape::ChainSegment).collect());
+            }
             _ => {
                 let p1 = s.point1.ok_or_else(|| need("point1"))?;
                 let p2 = s.point2.ok_or_else(|| need("point2"))?;
                 Shape::Segment(Segment::new(v(p1), v(p2)).map_err(|e| geo("point2", e))?)
             }
         };
-        Ok(shape)
+        Ok(vec![shape])
     }
 
     /// The engine material of a shape spec (validated by [`SceneFile::validate`]).
@@ -884,14 +934,16 @@ impl SceneFile {
                 ..BodyDef::default()
             };
             let id = world.create_body(&def).map_err(to_err(p.clone()))?;
-            for (j, (s, geometry)) in b.shapes.iter().zip(shapes).enumerate() {
+            for (j, (s, pieces)) in b.shapes.iter().zip(shapes).enumerate() {
                 let sp = format!("{p}.shapes[{j}]");
                 let def = ShapeDef {
                     material: self.shape_material(s),
                     filter: s.filter.map(Into::into).unwrap_or_default(),
                     ..ShapeDef::default()
                 };
-                world.create_shape(id, &def, geometry).map_err(to_err(sp))?;
+                for geometry in pieces {
+                    world.create_shape(id, &def, geometry).map_err(to_err(sp.clone()))?;
+                }
             }
             // The velocity in the file is that of the centre of mass: set it after the
             // shapes moved the centre.

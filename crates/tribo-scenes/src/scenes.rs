@@ -710,20 +710,13 @@ pub const SPINNER_CENTER: [f32; 2] = [0.0, 32.0];
 pub const SPINNER_RADIUS: f32 = 40.0;
 /// Speed of the spinner's rotor motor [rad/s].
 pub const SPINNER_MOTOR_SPEED: f32 = 5.0;
-/// Thickness [m] of the spinner's wall pieces, outward from the ring.
-pub const SPINNER_WALL: f32 = 2.5;
 
 /// Box2D v3's spinner benchmark scene (SCENES.md §2, `CreateSpinner`, HEAD sizes).
 ///
-/// Body 0: static ground, a closed ring through 360 points on a circle of radius 40 m
-/// about (0, 32) m, friction 0.1. Box2D's ring is a one-sided chain loop (wound
-/// clockwise: it pushes everything inwards); here each of its 360 pieces is a quad
-/// reaching [`SPINNER_WALL`] outwards from the chain's segment, so it is one-sided in
-/// effect in every engine. Two-sided segments are not: the rotor's rounded tip reaches
-/// 20.2 m from its pivot, 0.2 m past the ring at its lowest point, and bodies it squeezes
-/// there more than halfway through a segment are pushed out (Tribo lost 23 of 6 076 over
-/// 500 steps that way); with pieces 1 m thick a few bodies driven deep by the rotor still
-/// left through the back with μs raised to 1.5 μd. Body 1,
+/// Body 0: static ground, a chain loop through 360 points on a circle of radius 40 m
+/// about (0, 32) m, wound clockwise as Box2D's (its one-sided pieces push inwards),
+/// friction 0.1. (Until 2026-12-02 the ring was 360 quads 2.5 m thick: a body driven into
+/// it could be held between two quads' side faces.) Body 1,
 /// "rotor": a dynamic rounded box half (0.4, 20) m with radius 0.2 m at (0, 12) m,
 /// friction 0, density 1 kg/m², hinged to the ground at its centre by a revolute motor at
 /// 5 rad/s with unbounded torque (`f32::MAX`, as Box2D HEAD). Then 6 076 dynamic bodies,
@@ -748,22 +741,20 @@ pub fn spinner() -> SceneFile {
         let a = -(k as f32) * core::f32::consts::TAU / 360.0;
         [SPINNER_CENTER[0] + r * a.cos(), SPINNER_CENTER[1] + r * a.sin()]
     };
-    let walls = (0..360)
-        .map(|k| {
-            let outer = SPINNER_RADIUS + SPINNER_WALL;
-            polygon_shape(
-                vec![
-                    point(k, SPINNER_RADIUS),
-                    point(k + 1, SPINNER_RADIUS),
-                    point(k + 1, outer),
-                    point(k, outer),
-                ],
-                Some(MaterialRef::Inline(wall_material.clone())),
-            )
-        })
-        .collect();
-    s.bodies
-        .push(body(Some("ground".into()), BodyKind::Static, [0.0, 0.0], 0.0, walls));
+    let ring = ShapeSpec {
+        kind: "chain".into(),
+        points: Some((0..360).map(|k| point(k, SPINNER_RADIUS)).collect()),
+        closed: Some(true),
+        material: Some(MaterialRef::Inline(wall_material)),
+        ..ShapeSpec::default()
+    };
+    s.bodies.push(body(
+        Some("ground".into()),
+        BodyKind::Static,
+        [0.0, 0.0],
+        0.0,
+        vec![ring],
+    ));
     let rotor_material = MaterialSpec {
         density: Some(1.0),
         friction: Some(0.0),
@@ -1235,8 +1226,14 @@ mod benchmark_scene_tests {
         let s = spinner();
         assert_eq!((s.steps, s.gravity, s.enable_sleep), (500, [0.0, -10.0], true));
         assert_eq!(s.bodies.len(), 2 + 6076);
-        assert_eq!(s.bodies[0].shapes.len(), 360);
-        assert_eq!(s.bodies[0].shapes[0].kind, "polygon");
+        assert_eq!(s.bodies[0].shapes.len(), 1);
+        assert_eq!(s.bodies[0].shapes[0].kind, "chain");
+        assert_eq!(s.bodies[0].shapes[0].closed, Some(true));
+        let ring = s.bodies[0].shapes[0].points.as_ref().expect("points");
+        assert_eq!(ring.len(), 360);
+        // Clockwise: point 1 is at angle −1°.
+        let a1 = (ring[1][1] - 32.0).atan2(ring[1][0]);
+        assert!((a1 + 1f32.to_radians()).abs() < 1e-5, "{a1}");
         let motor = s.joints[0].motor.expect("motor");
         assert_eq!((motor.speed, s.joints[0].anchor), (5.0, [0.0, 12.0]));
         // 92 bodies per row from (−23, 2): the 93rd starts the second row.

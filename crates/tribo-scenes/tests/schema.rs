@@ -138,6 +138,8 @@ fn full_shape() -> ShapeSpec {
         center2: Some([1.0, 0.0]),
         point1: Some([0.0, 0.0]),
         point2: Some([1.0, 0.0]),
+        points: Some(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]),
+        closed: Some(true),
         material: Some(MaterialRef::Inline(full_material())),
         filter: Some(FilterSpec {
             category: 2,
@@ -240,6 +242,8 @@ fn sample(field: &str) -> Value {
         "vertices" => json!([[0, 0], [1, 0], [0, 1]]),
         "center1" | "point1" => json!([0, 0]),
         "center2" | "point2" => json!([1, 0]),
+        "points" => json!([[0, 0], [1, 0], [1, 1]]),
+        "loop" => json!(true),
         "material" => json!({ "friction": 0.5 }),
         "filter" => json!({ "category": 2, "mask": 1, "group": 0 }),
         other => panic!("no sample value for shape field {other}"),
@@ -427,7 +431,7 @@ fn schema_enums_are_the_serde_variants() {
     let variants: BTreeSet<String> = shape_variants(&root).into_keys().collect();
     let listed = enum_strings(&properties(def(&root, "shape"))["type"]);
     assert_eq!(variants, listed, "shape type enum vs oneOf variants");
-    let expected: BTreeSet<String> = ["circle", "box", "polygon", "capsule", "segment"]
+    let expected: BTreeSet<String> = ["circle", "box", "polygon", "capsule", "segment", "chain"]
         .into_iter()
         .map(String::from)
         .collect();

@@ -58,7 +58,7 @@ pub use collision::FrictionState;
 pub use dynamics::joint::{DEFAULT_CONSTRAINT_DAMPING_RATIO, DEFAULT_CONSTRAINT_HERTZ};
 pub use dynamics::{mix, BodyDef, BodyType, CombineRule, Filter, Material, MixedMaterial, RevoluteJointDef, ShapeDef};
 pub use error::{Error, Result};
-pub use geometry::{Capsule, Circle, GeometryError, MassData, Polygon, Segment, Shape};
+pub use geometry::{Capsule, ChainSegment, Circle, GeometryError, MassData, Polygon, Segment, Shape};
 pub use math::{Aabb, Rot, Transform, Vec2};
 pub use world::{
     BodyId, ContactBeginEvent, ContactEndEvent, ContactEvents, ContactInfo, ContactPointInfo, JointId, Profile,

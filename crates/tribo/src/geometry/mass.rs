@@ -216,7 +216,7 @@ impl Shape {
             Shape::Circle(c) => c.mass(density),
             Shape::Capsule(c) => c.mass(density),
             Shape::Polygon(p) => p.mass(density),
-            Shape::Segment(s) => s.mass(density),
+            Shape::Segment(s) | Shape::ChainSegment(super::ChainSegment { segment: s, .. }) => s.mass(density),
         }
     }
 }

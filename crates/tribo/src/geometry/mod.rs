@@ -21,7 +21,7 @@ pub(crate) use manifold::collide_bounded;
 pub use manifold::{collide, collide_after, Manifold, ManifoldPoint, MAX_MANIFOLD_POINTS};
 pub use mass::MassData;
 pub use raycast::{RayCastInput, RayHit};
-pub use shapes::{Capsule, Circle, Polygon, Segment, Shape, MAX_POLYGON_VERTICES};
+pub use shapes::{Capsule, ChainSegment, Circle, Polygon, Segment, Shape, MAX_POLYGON_VERTICES};
 pub(crate) use sweep::{first_contact, Sweep};
 
 use core::fmt;
@@ -41,6 +41,13 @@ pub enum GeometryError {
     TooManyVertices(usize),
     /// Two points that must differ (segment, capsule) coincide.
     DegenerateSegment(&'static str),
+    /// A chain needs more points (a loop 3, an open chain 2).
+    TooFewPoints {
+        /// Points needed.
+        needed: usize,
+        /// Points given.
+        got: usize,
+    },
 }
 
 impl fmt::Display for GeometryError {
@@ -55,6 +62,9 @@ impl fmt::Display for GeometryError {
                 "polygon hull has {n} vertices; at most {MAX_POLYGON_VERTICES} are supported"
             ),
             GeometryError::DegenerateSegment(what) => write!(f, "{what}: the two points coincide"),
+            GeometryError::TooFewPoints { needed, got } => {
+                write!(f, "a chain needs at least {needed} points (got {got})")
+            }
         }
     }
 }

@@ -6,7 +6,7 @@
 //! on the surface may report a hit at fraction 0. Invalid input (NaN, infinite, negative
 //! `max_fraction`, zero translation) reports no hit.
 
-use super::{Capsule, Circle, Polygon, Segment, Shape};
+use super::{Capsule, ChainSegment, Circle, Polygon, Segment, Shape};
 use crate::math::Vec2;
 
 /// A ray (or a swept point) in a shape's local frame.
@@ -258,6 +258,16 @@ impl Segment {
     }
 }
 
+impl ChainSegment {
+    /// Casts a ray against the piece's colliding side only (local frame), as Box2D does for
+    /// chains: a ray arriving from behind passes through. The normal is the piece's normal.
+    pub fn ray_cast(&self, input: &RayCastInput) -> Option<RayHit> {
+        let hit = self.segment.ray_cast(input)?;
+        // The segment's hit faces the ray origin: from the front it is the piece's normal.
+        (hit.normal.dot(self.normal()) > 0.0).then_some(hit)
+    }
+}
+
 impl Shape {
     /// Casts a ray against the shape; `input` is in the shape's local (body) frame and so is
     /// the hit. `None` when there is no hit within `max_fraction` or the origin is inside a
@@ -268,6 +278,7 @@ impl Shape {
             Shape::Capsule(c) => c.ray_cast(input),
             Shape::Polygon(p) => p.ray_cast(input),
             Shape::Segment(s) => s.ray_cast(input),
+            Shape::ChainSegment(c) => c.ray_cast(input),
         }
     }
 }
@@ -369,6 +380,17 @@ mod tests {
         assert!(b.ray_cast(&ray(v(0.44, 1.5), v(2.0, -2.0))).is_none());
         let sharp = Shape::Polygon(Polygon::new_box(1.25, 0.75).unwrap());
         assert!(sharp.ray_cast(&ray(v(0.44, 1.5), v(2.0, -2.0))).is_some());
+    }
+
+    /// A chain piece from (1, 0) to (−1, 0) faces up: a ray from above hits it with normal
+    /// (0, 1); the same ray from below passes.
+    #[test]
+    fn chain_segment_one_sided() {
+        let pieces = ChainSegment::chain(&[v(1.0, 0.0), v(-1.0, 0.0)], false).unwrap();
+        let s = Shape::ChainSegment(pieces[0]);
+        let h = s.ray_cast(&ray(v(0.5, 1.0), v(0.0, -2.0))).unwrap();
+        assert!(near(h.point, v(0.5, 0.0)) && near(h.normal, v(0.0, 1.0)), "{h:?}");
+        assert!(s.ray_cast(&ray(v(0.5, -1.0), v(0.0, 2.0))).is_none());
     }
 
     #[test]

@@ -35,6 +35,26 @@ pub struct Segment {
     pub point2: Vec2,
 }
 
+/// One piece of a chain: a segment that collides on its right side only (the side of
+/// `right_perp(point2 − point1)`), smoothed against its neighbours by two ghost vertices.
+///
+/// As in Box2D v3 (`b2ChainSegment`): a counter-clockwise loop faces outwards, a clockwise
+/// loop inwards. The ghost vertices are the far ends of the neighbouring pieces
+/// (`ghost1 → point1` before, `point2 → ghost2` after); contacts use them to drop the normals
+/// that would catch on an internal vertex (E. Catto, "Ghost collisions", box2d.org 2020: a
+/// normal is kept only inside the cone the two pieces' normals span at a convex vertex, and
+/// snapped to the segment's own normal at a concave one). Build them with
+/// [`ChainSegment::chain`]; zero mass, for static and kinematic bodies.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChainSegment {
+    /// End of the previous piece [m, body frame].
+    pub ghost1: Vec2,
+    /// The piece itself [m, body frame].
+    pub segment: Segment,
+    /// End of the next piece [m, body frame].
+    pub ghost2: Vec2,
+}
+
 /// A convex polygon with up to [`MAX_POLYGON_VERTICES`] counter-clockwise vertices and an
 /// optional rounding radius (the solid is the polygon grown by `radius`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -57,6 +77,8 @@ pub enum Shape {
     Polygon(Polygon),
     /// A segment (zero thickness, zero mass).
     Segment(Segment),
+    /// A one-sided piece of a chain (zero thickness, zero mass).
+    ChainSegment(ChainSegment),
 }
 
 /// Fails with `NonFinite(what)` unless both coordinates are finite.
@@ -143,6 +165,68 @@ impl Segment {
     /// Length [m].
     pub fn length(&self) -> f32 {
         (self.point2 - self.point1).length()
+    }
+}
+
+impl ChainSegment {
+    /// Unit normal of the colliding side, `right_perp(point2 − point1) / length` [body frame].
+    pub fn normal(&self) -> Vec2 {
+        (self.segment.point2 - self.segment.point1)
+            .right_perp()
+            .normalize_or_zero()
+    }
+
+    /// The pieces of a chain through `points` [m, body frame]: a closed loop (`closed`,
+    /// segment `i` from point `i` to point `i+1 mod n`, n pieces, each smoothed against both
+    /// neighbours) or an open chain (n − 1 pieces; the two free ends are convex corners of
+    /// 90°, so a shape reaching round an end touches its vertex). Each piece collides on its
+    /// right side: wind a loop clockwise to keep shapes inside it (Box2D's convention).
+    ///
+    /// Unlike Box2D v3, an open chain's first and last points are pieces' ends, not ghost
+    /// vertices (Box2D makes n − 3 pieces of n points).
+    ///
+    /// Errors: `NonFinite("points")`, `TooFewPoints` (a loop needs 3 points, an open chain
+    /// 2), `DegenerateSegment("chain points")` when two consecutive points (the last and the
+    /// first of a loop included) are closer than [`LINEAR_SLOP`].
+    pub fn chain(points: &[Vec2], closed: bool) -> Result<Vec<ChainSegment>, GeometryError> {
+        if points.iter().any(|p| !p.is_finite()) {
+            return Err(GeometryError::NonFinite("points"));
+        }
+        let needed = if closed { 3 } else { 2 };
+        if points.len() < needed {
+            return Err(GeometryError::TooFewPoints {
+                needed,
+                got: points.len(),
+            });
+        }
+        let n = points.len();
+        let pieces = if closed { n } else { n - 1 };
+        let at = |i: usize| points[i % n];
+        for i in 0..pieces {
+            if !((at(i + 1) - at(i)).length() >= LINEAR_SLOP) {
+                return Err(GeometryError::DegenerateSegment("chain points"));
+            }
+        }
+        let mut out = Vec::with_capacity(pieces);
+        for i in 0..pieces {
+            let (p1, p2) = (at(i), at(i + 1));
+            // A free end is a right-angled convex corner: its ghost lies behind the piece.
+            let behind = (p2 - p1).right_perp() * -1.0;
+            let ghost1 = if closed {
+                at(i + n - 1)
+            } else if i > 0 {
+                at(i - 1)
+            } else {
+                p1 + behind
+            };
+            let ghost2 = if closed || i + 2 < n { at(i + 2) } else { p2 + behind };
+            out.push(ChainSegment {
+                ghost1,
+                segment: Segment { point1: p1, point2: p2 },
+                ghost2,
+            });
+        }
+        Ok(out)
     }
 }
 
@@ -278,7 +362,7 @@ impl Shape {
                 let b = xf.apply(c.center2);
                 Aabb::new(a.min(b), a.max(b)).expand(c.radius)
             }
-            Shape::Segment(s) => {
+            Shape::Segment(s) | Shape::ChainSegment(ChainSegment { segment: s, .. }) => {
                 let a = xf.apply(s.point1);
                 let b = xf.apply(s.point2);
                 Aabb::new(a.min(b), a.max(b))
@@ -303,7 +387,7 @@ impl Shape {
         match self {
             Shape::Circle(c) => c.center,
             Shape::Capsule(c) => c.center1.lerp(c.center2, 0.5),
-            Shape::Segment(s) => s.point1.lerp(s.point2, 0.5),
+            Shape::Segment(s) | Shape::ChainSegment(ChainSegment { segment: s, .. }) => s.point1.lerp(s.point2, 0.5),
             Shape::Polygon(p) => p.centroid,
         }
     }
@@ -318,7 +402,7 @@ impl Shape {
                 let b = (c.center2 - local_center).length();
                 a.max(b) + c.radius
             }
-            Shape::Segment(s) => {
+            Shape::Segment(s) | Shape::ChainSegment(ChainSegment { segment: s, .. }) => {
                 let a = (s.point1 - local_center).length();
                 let b = (s.point2 - local_center).length();
                 a.max(b)
@@ -340,7 +424,7 @@ impl Shape {
         match self {
             Shape::Circle(c) => c.radius,
             Shape::Capsule(c) => c.radius,
-            Shape::Segment(_) => 0.0,
+            Shape::Segment(_) | Shape::ChainSegment(_) => 0.0,
             Shape::Polygon(p) => {
                 let mut min = f32::MAX;
                 for (v, n) in p.vertices().iter().zip(p.normals()) {

@@ -87,10 +87,18 @@ fn overlap(fixed: &Shape, xf_fixed: Transform, moving: &Shape, xf: Transform) ->
 /// The fraction of the step at which `moving`, carried by `sweep`, first overlaps `fixed`
 /// (at `xf_fixed`) by more than the linear slop: the last sampled or bisected fraction at
 /// which it does not. `None` when they already overlap so at the start or never do along
-/// the motion.
+/// the motion, or when `fixed` is a chain piece the moving shape's centroid starts behind.
 pub fn first_contact(fixed: &Shape, xf_fixed: Transform, moving: &Shape, sweep: &Sweep) -> Option<f32> {
     if overlap(fixed, xf_fixed, moving, sweep.at(0.0)) {
         return None;
+    }
+    // A chain piece lets through what starts behind it (as Box2D's continuous step does):
+    // once the centroid has crossed, the piece would report an overlap from its front.
+    if let Shape::ChainSegment(c) = fixed {
+        let centroid = xf_fixed.inv_apply(sweep.at(0.0).apply(moving.centroid()));
+        if c.normal().dot(centroid - c.segment.point1) < 0.0 {
+            return None;
+        }
     }
     let travel = sweep.travel(moving.max_extent(sweep.local_center));
     let step = (0.5 * moving.min_extent()).max(super::LINEAR_SLOP);

@@ -1183,6 +1183,22 @@ fn validate_geometry(g: &Shape) -> Result<()> {
                 return Err(Error::arg("Segment", "point1 and point2 coincide"));
             }
         }
+        Shape::ChainSegment(c) => {
+            check_vec("ChainSegment::ghost1", c.ghost1)?;
+            check_vec("ChainSegment::segment.point1", c.segment.point1)?;
+            check_vec("ChainSegment::segment.point2", c.segment.point2)?;
+            check_vec("ChainSegment::ghost2", c.ghost2)?;
+            let slop = crate::geometry::LINEAR_SLOP;
+            if (c.segment.point2 - c.segment.point1).length() < slop {
+                return Err(Error::arg("ChainSegment", "segment.point1 and segment.point2 coincide"));
+            }
+            if (c.segment.point1 - c.ghost1).length() < slop || (c.ghost2 - c.segment.point2).length() < slop {
+                return Err(Error::arg(
+                    "ChainSegment",
+                    "a ghost vertex coincides with its end point",
+                ));
+            }
+        }
         // Polygons can only be built through validated constructors (private fields).
         Shape::Polygon(_) => {}
     }

@@ -198,6 +198,16 @@ impl World {
         }
     }
 
+    /// Whether the pair with `key` has a contact with manifold points this step.
+    pub(crate) fn pair_has_points(&self, key: u64) -> bool {
+        let contact = self
+            .broad_phase
+            .pairs
+            .get(&key)
+            .and_then(|&ci| self.contacts.get(ci as usize));
+        matches!(contact, Some(Some(c)) if c.manifold.count > 0)
+    }
+
     fn create_contact(&mut self, sa: u32, sb: u32) {
         let (Some(a), Some(b)) = (self.shapes.at(sa), self.shapes.at(sb)) else {
             return;
@@ -862,6 +872,6 @@ fn rolling_radius(g: &Shape) -> f32 {
         Shape::Circle(c) => c.radius,
         Shape::Capsule(c) => c.radius,
         Shape::Polygon(p) => p.radius(),
-        Shape::Segment(_) => 0.0,
+        Shape::Segment(_) | Shape::ChainSegment(_) => 0.0,
     }
 }

@@ -27,6 +27,7 @@
 
 mod capsule_capsule;
 mod capsule_circle;
+mod chain_segment;
 mod circle_circle;
 mod polygon_capsule;
 mod polygon_circle;
@@ -89,12 +90,12 @@ impl Manifold {
 }
 
 /// Computes the contact manifold between `shape_a` placed by `xf_a` and `shape_b` placed by
-/// `xf_b` (all 16 ordered pairs of circle, capsule, polygon, segment).
+/// `xf_b` (all ordered pairs of circle, capsule, polygon, segment and chain segment).
 ///
 /// Points whose separation [m] is below `speculative_distance` [m] are kept (pass at least
-/// [`super::SPECULATIVE_DISTANCE`]; more for fast bodies). Segment–segment always gives an
-/// empty manifold: segments are zero-mass ground shapes and never move relative to each other
-/// through contact. Non-finite input gives an empty manifold or non-finite numbers, never a
+/// [`super::SPECULATIVE_DISTANCE`]; more for fast bodies). A pair of segments or chain
+/// segments always gives an empty manifold: they are zero-mass ground shapes and never move
+/// relative to each other through contact. Non-finite input gives an empty manifold or non-finite numbers, never a
 /// panic.
 pub fn collide(
     shape_a: &Shape,
@@ -167,7 +168,29 @@ pub(crate) fn collide_bounded(
         (Shape::Segment(a), Shape::Polygon(b)) => {
             flip(polygon_segment::collide_polygon_segment(b, xf_b, a, xf_a, spec))
         }
-        (Shape::Segment(_), Shape::Segment(_)) => (Manifold::EMPTY, 0.0),
+
+        (Shape::ChainSegment(a), Shape::Circle(b)) => chain_segment::collide_chain_circle(a, xf_a, b, xf_b, spec),
+        (Shape::ChainSegment(a), Shape::Capsule(b)) => chain_segment::collide_chain_capsule(a, xf_a, b, xf_b, spec),
+        (Shape::ChainSegment(a), Shape::Polygon(b)) => {
+            chain_segment::collide_chain_polygon(a, xf_a, b, xf_b, spec, last_reference_b(last))
+        }
+        (Shape::Circle(a), Shape::ChainSegment(b)) => flip(chain_segment::collide_chain_circle(b, xf_b, a, xf_a, spec)),
+        (Shape::Capsule(a), Shape::ChainSegment(b)) => {
+            flip(chain_segment::collide_chain_capsule(b, xf_b, a, xf_a, spec))
+        }
+        (Shape::Polygon(a), Shape::ChainSegment(b)) => flip(chain_segment::collide_chain_polygon(
+            b,
+            xf_b,
+            a,
+            xf_a,
+            spec,
+            last_reference_b(last),
+        )),
+
+        // Zero-mass ground shapes never push each other.
+        (Shape::Segment(_) | Shape::ChainSegment(_), Shape::Segment(_) | Shape::ChainSegment(_)) => {
+            (Manifold::EMPTY, 0.0)
+        }
     }
 }
 
@@ -462,7 +485,9 @@ mod bound_tests {
                 Shape::Polygon(p) => (p.vertices().iter().map(|&v| xf.apply(v)).collect(), p.radius()),
                 Shape::Circle(c) => (vec![xf.apply(c.center)], c.radius),
                 Shape::Capsule(c) => (vec![xf.apply(c.center1), xf.apply(c.center2)], c.radius),
-                Shape::Segment(g) => (vec![xf.apply(g.point1), xf.apply(g.point2)], 0.0),
+                Shape::Segment(g) | Shape::ChainSegment(crate::geometry::ChainSegment { segment: g, .. }) => {
+                    (vec![xf.apply(g.point1), xf.apply(g.point2)], 0.0)
+                }
             }
         }
         fn to_edges(p: Vec2, vs: &[Vec2]) -> f32 {
@@ -481,8 +506,8 @@ mod bound_tests {
 
     #[test]
     fn separation_bound_never_exceeds_the_distance() {
-        // A box, a rounded triangle, a circle, a capsule and a segment at many poses around
-        // each other (every pair but segment–segment): whenever
+        // A box, a rounded triangle, a circle, a capsule, a segment and a chain piece at many
+        // poses around each other (every pair but those of two ground shapes): whenever
         // collide_bounded reports the pair apart with a bound, the bound is at most the
         // true surface distance (to 10 µm of f32 rounding), and the manifold is empty.
         let shapes = [
@@ -493,11 +518,18 @@ mod bound_tests {
             Shape::Circle(Circle::new(Vec2::new(0.1, -0.2), 0.4).unwrap()),
             Shape::Capsule(Capsule::new(Vec2::new(-0.4, 0.0), Vec2::new(0.4, 0.1), 0.2).unwrap()),
             Shape::Segment(Segment::new(Vec2::new(-0.6, -0.3), Vec2::new(0.7, 0.2)).unwrap()),
+            // A chain piece with a convex vertex behind point1 and a concave one after point2.
+            Shape::ChainSegment(crate::geometry::ChainSegment {
+                ghost1: Vec2::new(-0.9, -1.0),
+                segment: Segment::new(Vec2::new(-0.6, -0.3), Vec2::new(0.7, 0.2)).unwrap(),
+                ghost2: Vec2::new(1.0, -0.8),
+            }),
         ];
         let mut seen = 0;
         for a in &shapes {
             for b in &shapes {
-                if matches!((a, b), (Shape::Segment(_), Shape::Segment(_))) {
+                let ground = |s: &Shape| matches!(s, Shape::Segment(_) | Shape::ChainSegment(_));
+                if ground(a) && ground(b) {
                     continue;
                 }
                 for k in 0..400 {

@@ -103,7 +103,7 @@ fn near_contact_placements(a: &Shape, b: &Shape, target: f32) -> Vec<(Transform,
 }
 
 /// collide(a, b) and collide(b, a) must describe the same contact.
-fn assert_symmetric(a: &Shape, xa: Transform, b: &Shape, xb: Transform, what: &str) {
+pub(crate) fn assert_symmetric(a: &Shape, xa: Transform, b: &Shape, xb: Transform, what: &str) {
     let spec = SPECULATIVE_DISTANCE;
     let m1 = collide(a, xa, b, xb, spec);
     let m2 = collide(b, xb, a, xa, spec);
