@@ -41,6 +41,13 @@ pub struct BodyDef {
     pub gravity_scale: f32,
     /// Prevents rotation (infinite rotational inertia).
     pub fixed_rotation: bool,
+    /// A fast, small body that must not pass through other moving bodies (Box2D's
+    /// `isBullet`): its shapes' boxes are swept along each step's motion even while it
+    /// touches something, so its pairs exist before it gets there and the speculative
+    /// contact catches it. Other bodies' boxes are swept only while they touch nothing (in
+    /// flight), and every dynamic body is stopped at static shapes by continuous collision;
+    /// a bullet in a moving pile costs pairs. Default false.
+    pub bullet: bool,
     /// Constant force [N] applied at the centre of mass every step, until changed.
     pub constant_force: Vec2,
     /// Constant torque [N·m] applied every step, until changed.
@@ -67,6 +74,7 @@ impl Default for BodyDef {
             angular_damping: 0.0,
             gravity_scale: 1.0,
             fixed_rotation: false,
+            bullet: false,
             constant_force: Vec2::ZERO,
             constant_torque: 0.0,
             enable_sleep: true,
@@ -145,6 +153,8 @@ pub(crate) struct Body {
     pub linear_damping: f32,
     pub angular_damping: f32,
     pub fixed_rotation: bool,
+    /// Boxes swept along the motion ([`BodyDef::bullet`]).
+    pub bullet: bool,
     pub constant_force: Vec2,
     pub constant_torque: f32,
     /// Forces applied through `apply_force*` since the last step; cleared by the step.
@@ -193,6 +203,7 @@ impl Body {
             linear_damping: def.linear_damping,
             angular_damping: def.angular_damping,
             fixed_rotation: def.fixed_rotation,
+            bullet: def.bullet,
             constant_force: def.constant_force,
             constant_torque: def.constant_torque,
             force: Vec2::ZERO,

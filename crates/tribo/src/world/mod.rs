@@ -213,6 +213,8 @@ pub struct World {
     /// Scratch of a parallel finalize: per awake body, its one shape's next box when it
     /// stays inside the fat box (see `World::finalize`).
     pub(crate) scratch_boxes: Vec<Option<Aabb>>,
+    /// Per solver slot: touched something this step (`finalize`'s sweep rule).
+    pub(crate) scratch_touched: Vec<bool>,
     /// Per body slot, what the solver's constraints need of it (rebuilt every step).
     pub(crate) solver_bodies: Vec<crate::solver::SolverBody>,
     pub(crate) step_count: u64,
@@ -267,6 +269,7 @@ impl World {
             scratch_mark: Vec::new(),
             scratch_flags: Vec::new(),
             scratch_boxes: Vec::new(),
+            scratch_touched: Vec::new(),
             shared_states: Vec::new(),
             solver_bodies: Vec::new(),
             step_count: 0,
@@ -475,7 +478,7 @@ impl World {
         b.center0 = b.center;
         b.q0 = b.xf.q;
         self.wake_body(id.index);
-        self.refresh_body_proxies(id.index, 0.0);
+        self.refresh_body_proxies(id.index, 0.0, false);
         Ok(())
     }
 
@@ -597,6 +600,12 @@ impl World {
         let b = self.body_mut(id)?;
         b.linear_damping = linear;
         b.angular_damping = angular;
+        Ok(())
+    }
+
+    /// Makes a body a bullet or not ([`BodyDef::bullet`]), from its next step on.
+    pub fn set_body_bullet(&mut self, id: BodyId, bullet: bool) -> Result<()> {
+        self.body_mut(id)?.bullet = bullet;
         Ok(())
     }
 
@@ -892,13 +901,13 @@ impl World {
 
     /// Updates the fat boxes of a body's shapes after its pose changed.
     /// `dt` > 0 (a step's finalize) also sweeps the boxes along the body's velocity for the
-    /// next step, and first stops a dynamic body that moved out of the region its pairs
+    /// next step (if `sweep`: a bullet, or a body that touched nothing), and first stops a dynamic body that moved out of the region its pairs
     /// covered at the first static shape in its way ([`World::stop_at_static_shapes`]).
-    pub(crate) fn refresh_body_proxies(&mut self, body_index: u32, dt: f32) {
-        if let Some(escaped) = self.refresh_boxes(body_index, dt, 0, true) {
+    pub(crate) fn refresh_body_proxies(&mut self, body_index: u32, dt: f32, sweep: bool) {
+        if let Some(escaped) = self.refresh_boxes(body_index, dt, 0, true, sweep) {
             // A shape ended the step outside the fat box its pairs were found with.
             let moved = self.stop_at_static_shapes(body_index);
-            self.refresh_boxes(body_index, dt, if moved { 0 } else { escaped }, false);
+            self.refresh_boxes(body_index, dt, if moved { 0 } else { escaped }, false, sweep);
         }
     }
 
@@ -908,18 +917,19 @@ impl World {
     /// one that left it by more than the speculative distance plus the slop, returning its
     /// position in the body's shape list (the shapes before it are updated); the box is
     /// computed once either way.
-    fn refresh_boxes(&mut self, body_index: u32, dt: f32, first: usize, check: bool) -> Option<usize> {
+    fn refresh_boxes(&mut self, body_index: u32, dt: f32, first: usize, check: bool, sweep: bool) -> Option<usize> {
         // Disjoint field borrows: no copy of the shape list in this per-step path.
         let Some(b) = self.bodies.at(body_index) else {
             return None;
         };
         let check = check && dt > 0.0 && b.body_type == BodyType::Dynamic;
         let (xf, v) = (b.xf, box_velocity(b, self.def.max_linear_speed));
+        let moved = (b.center - b.center0).length();
         for (k, &sid) in b.shapes.iter().enumerate().skip(first) {
             let Some(s) = self.shapes.get_mut(sid.index, sid.generation) else {
                 continue;
             };
-            let Some(aabb) = next_box(s, xf, v, dt, check) else {
+            let Some(aabb) = next_box(s, xf, v, dt, check, sweep, moved) else {
                 return Some(k);
             };
             s.aabb = aabb;
@@ -1134,18 +1144,39 @@ pub(crate) fn box_velocity(b: &Body, limit: f32) -> Vec2 {
     }
 }
 
-/// A shape's box for the next step at the body's pose `xf` (swept along `v` for `dt`), or
-/// `None` when `check` finds the shape escaped: a static shape the body has no pair with
-/// had its fat box (its box grown by the speculative distance) apart from this one's, so a
-/// shape poking out of its fat box by less than the speculative distance plus the slop
-/// overlaps it by the slop at most: only a shape further out can be where nothing stopped
-/// it ([`World::stop_at_static_shapes`]).
-pub(crate) fn next_box(s: &ShapeRecord, xf: Transform, v: Vec2, dt: f32, check: bool) -> Option<Aabb> {
+/// A shape's box for the next step at the body's pose `xf` (swept along `v` for `dt` when
+/// `sweep`, see [`sweep_free`]), or `None` when `check` finds that the body must first be
+/// checked against static shapes ([`World::stop_at_static_shapes`]):
+/// - the shape escaped: a static shape the body has no pair with had its fat box (its box
+///   grown by the speculative distance) apart from this one's, so a shape poking out of its
+///   fat box by less than the speculative distance plus the slop overlaps it by the slop at
+///   most: only a shape further out can be where nothing stopped it;
+/// - or its boxes are swept and the body moved further this step (`moved` [m]) than the
+///   shape may move unswept: the swept box held the motion, but a speculative contact is
+///   only as good as the normal it had at the start of the step (a chain piece's, say, far
+///   from where the body arrives), so fast bodies are checked as Box2D checks them.
+pub(crate) fn next_box(
+    s: &ShapeRecord,
+    xf: Transform,
+    v: Vec2,
+    dt: f32,
+    check: bool,
+    sweep: bool,
+    moved: f32,
+) -> Option<Aabb> {
     let tight = s.geometry.aabb(xf);
     if check && !s.fat_aabb.expand(SPECULATIVE_DISTANCE + LINEAR_SLOP).contains(tight) {
         return None;
     }
-    Some(swept_box(tight, v, dt, s.sweep_free))
+    if check && sweep && moved > s.sweep_free {
+        return None;
+    }
+    Some(swept_box(
+        tight,
+        v,
+        dt,
+        if sweep { s.sweep_free } else { f32::INFINITY },
+    ))
 }
 
 /// [`shape_box`] from the shape's tight box at its pose.

@@ -610,6 +610,22 @@ impl World {
                 b.sleep_time = 0.0;
             }
         });
+        // Which solver slots touched something this step: their boxes are not swept
+        // (broad_phase::sweep_free), unless the body is a bullet.
+        let mut touched = core::mem::take(&mut self.scratch_touched);
+        touched.clear();
+        touched.resize(self.states.len(), false);
+        for &ci in &self.touching_contacts {
+            if let Some(Some(c)) = self.contacts.get(ci as usize) {
+                for body in [c.body_a, c.body_b] {
+                    if let Some(slot) = self.solver_bodies.get(body as usize).map(|sb| sb.index as usize) {
+                        if let Some(t) = touched.get_mut(slot) {
+                            *t = true;
+                        }
+                    }
+                }
+            }
+        }
         // With threads, the boxes of one-shape bodies are computed in parallel first; a box
         // that stays inside its fat box is then only stored by the serial pass below.
         let mut boxes = core::mem::take(&mut self.scratch_boxes);
@@ -617,6 +633,7 @@ impl World {
         if parallel && dt > 0.0 {
             boxes.resize(self.states.len(), None);
             let (bodies, shapes, sims, limit) = (&self.bodies, &self.shapes, &self.sims, self.def.max_linear_speed);
+            let touched = &touched;
             for_each_mut(parallel, &mut boxes, BODY_CHUNK, |k, out| {
                 let Some(b) = sims.get(k).filter(|_| k > 0).and_then(|sim| bodies.at(sim.body)) else {
                     return;
@@ -629,7 +646,10 @@ impl World {
                     return;
                 };
                 let check = b.body_type == BodyType::Dynamic;
-                *out = next_box(s, b.xf, box_velocity(b, limit), dt, check).filter(|aabb| s.fat_aabb.contains(*aabb));
+                let sweep = b.bullet || !touched[k];
+                let moved = (b.center - b.center0).length();
+                *out = next_box(s, b.xf, box_velocity(b, limit), dt, check, sweep, moved)
+                    .filter(|aabb| s.fat_aabb.contains(*aabb));
             });
         }
         // Fat boxes and the trees, in solver order (the trees are shared).
@@ -653,10 +673,14 @@ impl World {
                         copy_boxes(&mut self.shape_bounds, sid.index, s);
                     }
                 }
-                _ => self.refresh_body_proxies(bi, dt),
+                _ => {
+                    let sweep = b.bullet || !touched[k];
+                    self.refresh_body_proxies(bi, dt, sweep)
+                }
             }
         }
         self.scratch_boxes = boxes;
+        self.scratch_touched = touched;
     }
 
     /// Islands (awake dynamic bodies linked by touching contacts) whose every body has

@@ -141,6 +141,8 @@ pub(crate) fn collide_bounded(
     last: &Manifold,
 ) -> (Manifold, f32) {
     let spec = speculative_distance;
+    // A chain piece keeps holding a shape it had a manifold with (chain_segment, step 1).
+    let held = last.count > 0;
     match (shape_a, shape_b) {
         (Shape::Circle(a), Shape::Circle(b)) => circle_circle::collide_circles(a, xf_a, b, xf_b, spec),
         (Shape::Circle(a), Shape::Capsule(b)) => flip(capsule_circle::collide_capsule_circle(b, xf_b, a, xf_a, spec)),
@@ -169,14 +171,18 @@ pub(crate) fn collide_bounded(
             flip(polygon_segment::collide_polygon_segment(b, xf_b, a, xf_a, spec))
         }
 
-        (Shape::ChainSegment(a), Shape::Circle(b)) => chain_segment::collide_chain_circle(a, xf_a, b, xf_b, spec),
-        (Shape::ChainSegment(a), Shape::Capsule(b)) => chain_segment::collide_chain_capsule(a, xf_a, b, xf_b, spec),
-        (Shape::ChainSegment(a), Shape::Polygon(b)) => {
-            chain_segment::collide_chain_polygon(a, xf_a, b, xf_b, spec, last_reference_b(last))
+        (Shape::ChainSegment(a), Shape::Circle(b)) => chain_segment::collide_chain_circle(a, xf_a, b, xf_b, spec, held),
+        (Shape::ChainSegment(a), Shape::Capsule(b)) => {
+            chain_segment::collide_chain_capsule(a, xf_a, b, xf_b, spec, held)
         }
-        (Shape::Circle(a), Shape::ChainSegment(b)) => flip(chain_segment::collide_chain_circle(b, xf_b, a, xf_a, spec)),
+        (Shape::ChainSegment(a), Shape::Polygon(b)) => {
+            chain_segment::collide_chain_polygon(a, xf_a, b, xf_b, spec, last_reference_b(last), held)
+        }
+        (Shape::Circle(a), Shape::ChainSegment(b)) => {
+            flip(chain_segment::collide_chain_circle(b, xf_b, a, xf_a, spec, held))
+        }
         (Shape::Capsule(a), Shape::ChainSegment(b)) => {
-            flip(chain_segment::collide_chain_capsule(b, xf_b, a, xf_a, spec))
+            flip(chain_segment::collide_chain_capsule(b, xf_b, a, xf_a, spec, held))
         }
         (Shape::Polygon(a), Shape::ChainSegment(b)) => flip(chain_segment::collide_chain_polygon(
             b,
@@ -185,6 +191,7 @@ pub(crate) fn collide_bounded(
             xf_a,
             spec,
             last_reference_b(last),
+            held,
         )),
 
         // Zero-mass ground shapes never push each other.
