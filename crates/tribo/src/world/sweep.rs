@@ -1,11 +1,13 @@
 //! Continuous collision against static shapes for bodies that moved further in a step
-//! than their pairs covered (see [`crate::geometry::first_contact`]).
+//! than their pairs covered, or fast bodies whose boxes were swept (see
+//! [`crate::geometry::first_contact`] and `world::next_box`).
 //!
-//! The pairs a body is solved with come from its fat boxes at the start of the step,
-//! swept along its velocity then. An impulse inside the step can send it much further:
-//! in Box2D's spinner a box the rotor's tip hits at 70 m/s is kicked 0.7 m into the ring's
-//! wall in one step, where it has no pair; it ends in the seam between two wall pieces and
-//! their side faces push it out through the wall at 240 m/s. Such a body is stopped where
+//! The pairs a body is solved with come from its fat boxes at the start of the step (swept
+//! along its velocity then only for a body in flight or a bullet). A body faster than its
+//! boxes' room, or an impulse inside the step, can send it further: in Box2D's spinner a box
+//! the rotor's tip hits at 70 m/s is kicked 0.7 m into the ring in one step, where it has
+//! no contact points; a wall of quads then held it in the seam between two pieces, a chain
+//! let it through. Such a body is stopped where
 //! it first touches a static shape along its motion, as Box2D v3 stops fast bodies at
 //! their time of impact against static shapes; its velocity is kept, and the next step's
 //! pairs and speculative contact take it from there.
