@@ -90,9 +90,6 @@ fn overlap(fixed: &Shape, xf_fixed: Transform, moving: &Shape, xf: Transform) ->
 /// the motion, or when `fixed` is a chain piece the moving shape's centroid starts behind
 /// or skims (see the early out in the body).
 pub fn first_contact(fixed: &Shape, xf_fixed: Transform, moving: &Shape, sweep: &Sweep) -> Option<f32> {
-    if overlap(fixed, xf_fixed, moving, sweep.at(0.0)) {
-        return None;
-    }
     // A chain piece lets through what starts behind it, and is not worth a search for a
     // shape that moves along it: Box2D's early out (its continuous query callback), a
     // centroid that approaches by less than a quarter of the shape's thickness and ends
@@ -108,6 +105,9 @@ pub fn first_contact(fixed: &Shape, xf_fixed: Transform, moving: &Shape, sweep: 
         if start < 0.0 || (start - end < core && end > core) {
             return None;
         }
+    }
+    if overlap(fixed, xf_fixed, moving, sweep.at(0.0)) {
+        return None;
     }
     let travel = sweep.travel(moving.max_extent(sweep.local_center));
     let step = (0.5 * moving.min_extent()).max(super::LINEAR_SLOP);

@@ -215,6 +215,8 @@ pub struct World {
     pub(crate) scratch_boxes: Vec<Option<Aabb>>,
     /// Per solver slot: touched something this step (`finalize`'s sweep rule).
     pub(crate) scratch_touched: Vec<bool>,
+    /// Static shapes found by the continuous check (`stop_at_static_shapes`).
+    pub(crate) scratch_found: Vec<u32>,
     /// Per body slot, what the solver's constraints need of it (rebuilt every step).
     pub(crate) solver_bodies: Vec<crate::solver::SolverBody>,
     pub(crate) step_count: u64,
@@ -270,6 +272,7 @@ impl World {
             scratch_flags: Vec::new(),
             scratch_boxes: Vec::new(),
             scratch_touched: Vec::new(),
+            scratch_found: Vec::new(),
             shared_states: Vec::new(),
             solver_bodies: Vec::new(),
             step_count: 0,

@@ -23,12 +23,30 @@ impl World {
     /// the linear slop, a static shape it may collide with (filters and joints respected)
     /// and had no contact points with this step. Its velocity is unchanged. Returns whether it moved.
     pub(crate) fn stop_at_static_shapes(&mut self, body_index: u32) -> bool {
+        let mut found = core::mem::take(&mut self.scratch_found);
+        let first = self.first_static_contact(body_index, &mut found);
+        self.scratch_found = found;
+        match first {
+            Some((first, sweep)) if first < 1.0 => {
+                let xf = sweep.at(first);
+                if let Some(b) = self.bodies.at_mut(body_index) {
+                    b.xf = xf;
+                    b.center = xf.apply(b.local_center);
+                    return true;
+                }
+                false
+            }
+            _ => false,
+        }
+    }
+
+    /// The first fraction of this step's motion at which the body overlaps a static shape
+    /// it had no contact points with (1 when none), and the motion; `found` is scratch.
+    fn first_static_contact(&self, body_index: u32, found: &mut Vec<u32>) -> Option<(f32, Sweep)> {
         let tree = &self.broad_phase.trees[STATIC_TREE as usize];
-        let Some(b) = self.bodies.at(body_index) else {
-            return false;
-        };
+        let b = self.bodies.at(body_index)?;
         if tree.proxy_count() == 0 {
-            return false;
+            return None;
         }
         let sweep = step_motion(b);
         let bulge = sweep_bulge(&sweep, b.max_extent);
@@ -42,12 +60,12 @@ impl World {
             // from the chord between its two end positions during the turn (the body's
             // reach bounds each shape's).
             let swept = s.aabb.union(s.geometry.aabb(b.xf)).expand(bulge);
-            let mut found: Vec<u32> = Vec::new();
+            found.clear();
             tree.query(swept, s.filter.mask, |_, data| {
                 found.push(data as u32);
                 true
             });
-            for other in found {
+            for &other in found.iter() {
                 // A pair with contact points was in this step's solve, with a speculative
                 // margin for the motion the step began with. A pair without points was
                 // beyond that margin when the step began: an impulse inside the step (the
@@ -71,15 +89,7 @@ impl World {
                 }
             }
         }
-        if first < 1.0 {
-            let xf = sweep.at(first);
-            if let Some(b) = self.bodies.at_mut(body_index) {
-                b.xf = xf;
-                b.center = xf.apply(b.local_center);
-                return true;
-            }
-        }
-        false
+        Some((first, sweep))
     }
 }
 
