@@ -374,7 +374,8 @@ mod box2d_sim {
                     .linear_damping(b.linear_damping)
                     .angular_damping(b.angular_damping)
                     .gravity_scale(b.gravity_scale)
-                    .motion_locks(MotionLocks::new(false, false, b.fixed_rotation));
+                    .motion_locks(MotionLocks::new(false, false, b.fixed_rotation))
+                    .bullet(b.bullet);
             }
             let id = world.create_body(builder.build()?)?;
             {
@@ -683,6 +684,8 @@ mod rapier_sim {
                 if b.fixed_rotation {
                     builder = builder.lock_rotations();
                 }
+                // Rapier's continuous collision is its nearest to a bullet.
+                builder = builder.ccd_enabled(b.bullet);
             }
             let handle = world.bodies.insert(builder.build());
             for s in &b.shapes {

@@ -257,6 +257,10 @@ pub struct BodySpec {
     /// Prevents rotation. Default false.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub fixed_rotation: bool,
+    /// A bullet: its boxes are swept along its motion even while it touches something, so
+    /// it does not pass thin moving bodies (Box2D's `isBullet`). Default false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub bullet: bool,
     /// Whether the body starts awake. Default true.
     #[serde(default = "default_true", skip_serializing_if = "is_true")]
     pub awake: bool,
@@ -926,6 +930,7 @@ impl SceneFile {
                 angular_damping: b.angular_damping,
                 gravity_scale: b.gravity_scale,
                 fixed_rotation: b.fixed_rotation,
+                bullet: b.bullet,
                 constant_force: Vec2::new(b.force[0], b.force[1]),
                 constant_torque: b.torque,
                 awake: b.awake,

@@ -185,6 +185,7 @@ fn full_body() -> BodySpec {
         linear_damping: 0.1,
         angular_damping: 0.2,
         fixed_rotation: true,
+        bullet: true,
         awake: false,
         sleep_threshold: Some(0.1),
         shapes: vec![full_shape()],
