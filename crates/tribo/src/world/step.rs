@@ -567,6 +567,10 @@ impl World {
     fn finalize(&mut self, dt: f32, parallel: bool) {
         // Poses and sleep timers, body by body (in parallel: each body writes itself).
         let (states, sleep_on, solver_bodies) = (&self.states, self.def.enable_sleep, &self.solver_bodies);
+        // Whether any body moved, or will move, more than the speculative distance per step:
+        // only then can a box be swept or a swept body need the continuous check, and only
+        // then does it matter which bodies touched something.
+        let any_fast = core::sync::atomic::AtomicBool::new(false);
         self.bodies.for_each_live_mut(parallel, BODY_CHUNK, |bi, b| {
             let index = solver_bodies.get(bi as usize).map_or(0, |sb| sb.index);
             if index == 0 {
@@ -587,6 +591,9 @@ impl World {
             }
             b.v = s.v;
             b.w = s.w;
+            if s.v.length() * dt > SPECULATIVE_DISTANCE || s.dp.length() > SPECULATIVE_DISTANCE {
+                any_fast.store(true, core::sync::atomic::Ordering::Relaxed);
+            }
             b.center0 = b.center;
             b.q0 = b.xf.q;
             b.center += s.dp;
@@ -615,7 +622,8 @@ impl World {
         let mut touched = core::mem::take(&mut self.scratch_touched);
         touched.clear();
         touched.resize(self.states.len(), false);
-        for &ci in &self.touching_contacts {
+        let fast = any_fast.load(core::sync::atomic::Ordering::Relaxed);
+        for &ci in self.touching_contacts.iter().filter(|_| fast) {
             if let Some(Some(c)) = self.contacts.get(ci as usize) {
                 for body in [c.body_a, c.body_b] {
                     if let Some(slot) = self.solver_bodies.get(body as usize).map(|sb| sb.index as usize) {
