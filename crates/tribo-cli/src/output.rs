@@ -120,8 +120,7 @@ fn shape_colors(scene: &SceneFile, keys: &mut HashMap<String, usize>) -> Vec<Vec
                     let n = keys.len();
                     let idx = *keys.entry(key).or_insert(n);
                     let pieces = match (s.kind.as_str(), &s.points) {
-                        ("chain", Some(p)) if s.closed == Some(true) => p.len(),
-                        ("chain", Some(p)) => p.len().saturating_sub(1),
+                        ("chain", Some(p)) => tribo::ChainSegment::piece_count(p.len(), s.closed == Some(true)),
                         _ => 1,
                     };
                     std::iter::repeat_n(PALETTE[idx % PALETTE.len()], pieces)

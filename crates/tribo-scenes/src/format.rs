@@ -827,16 +827,12 @@ impl SceneFile {
                 let closed = s.closed.unwrap_or(false);
                 let pts: Vec<Vec2> = pts.iter().map(|&p| v(p)).collect();
                 // Name the point that ends a too short piece.
-                let n = pts.len();
-                let pieces = if closed { n } else { n.saturating_sub(1) };
-                if let Some(k) =
-                    (0..pieces).find(|&k| !((pts[(k + 1) % n] - pts[k]).length() >= tribo::geometry::LINEAR_SLOP))
-                {
+                if let Some(end) = ChainSegment::short_piece(&pts, closed) {
+                    let start = (end + pts.len() - 1) % pts.len();
                     return Err((
-                        format!("{path}.points[{}]", (k + 1) % n),
+                        format!("{path}.points[{end}]"),
                         format!(
-                            "chain point {} lies within {} m of point {k}: pieces must be at least that long",
-                            (k + 1) % n,
+                            "chain point {end} lies within {} m of point {start}: pieces must be at least that long",
                             tribo::geometry::LINEAR_SLOP
                         ),
                     ));

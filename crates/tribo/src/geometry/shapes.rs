@@ -169,6 +169,25 @@ impl Segment {
 }
 
 impl ChainSegment {
+    /// How many pieces [`ChainSegment::chain`] makes of `points` points: `points` for a loop,
+    /// `points − 1` for an open chain (0 for none).
+    pub fn piece_count(points: usize, closed: bool) -> usize {
+        if closed {
+            points
+        } else {
+            points.saturating_sub(1)
+        }
+    }
+
+    /// The index of the first point that ends a piece shorter than [`LINEAR_SLOP`] (the
+    /// closing piece of a loop ends at point 0), or `None`.
+    pub fn short_piece(points: &[Vec2], closed: bool) -> Option<usize> {
+        let n = points.len();
+        (0..ChainSegment::piece_count(n, closed))
+            .map(|k| (k + 1) % n)
+            .find(|&end| !((points[end] - points[(end + n - 1) % n]).length() >= LINEAR_SLOP))
+    }
+
     /// Unit normal of the colliding side, `right_perp(point2 − point1) / length` [body frame].
     pub fn normal(&self) -> Vec2 {
         (self.segment.point2 - self.segment.point1)
@@ -199,19 +218,17 @@ impl ChainSegment {
                 got: points.len(),
             });
         }
-        let n = points.len();
-        let pieces = if closed { n } else { n - 1 };
-        let at = |i: usize| points[i % n];
-        for i in 0..pieces {
-            if !((at(i + 1) - at(i)).length() >= LINEAR_SLOP) {
-                return Err(GeometryError::DegenerateSegment("chain points"));
-            }
+        if ChainSegment::short_piece(points, closed).is_some() {
+            return Err(GeometryError::DegenerateSegment("chain points"));
         }
+        let n = points.len();
+        let pieces = ChainSegment::piece_count(n, closed);
+        let at = |i: usize| points[i % n];
         let mut out = Vec::with_capacity(pieces);
         for i in 0..pieces {
             let (p1, p2) = (at(i), at(i + 1));
             // A free end is a right-angled convex corner: its ghost lies behind the piece.
-            let behind = (p2 - p1).right_perp() * -1.0;
+            let behind = -(p2 - p1).right_perp();
             let ghost1 = if closed {
                 at(i + n - 1)
             } else if i > 0 {

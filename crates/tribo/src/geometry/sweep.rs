@@ -96,9 +96,10 @@ pub fn first_contact(fixed: &Shape, xf_fixed: Transform, moving: &Shape, sweep: 
     // more than that in front; any overlap then is shallow and the next step's contact
     // takes it.
     if let Shape::ChainSegment(c) = fixed {
+        let (normal, local_centroid) = (c.normal(), moving.centroid());
         let offset = |t: f32| {
-            let centroid = xf_fixed.inv_apply(sweep.at(t).apply(moving.centroid()));
-            c.normal().dot(centroid - c.segment.point1)
+            let centroid = xf_fixed.inv_apply(sweep.at(t).apply(local_centroid));
+            normal.dot(centroid - c.segment.point1)
         };
         let (start, end) = (offset(0.0), offset(1.0));
         let core = 0.25 * moving.min_extent();

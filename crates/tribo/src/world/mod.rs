@@ -904,8 +904,9 @@ impl World {
 
     /// Updates the fat boxes of a body's shapes after its pose changed.
     /// `dt` > 0 (a step's finalize) also sweeps the boxes along the body's velocity for the
-    /// next step (if `sweep`: a bullet, or a body that touched nothing), and first stops a dynamic body that moved out of the region its pairs
-    /// covered at the first static shape in its way ([`World::stop_at_static_shapes`]).
+    /// next step (if `sweep`: a bullet, or a body that touched nothing), and first stops a
+    /// dynamic body that moved out of the region its pairs covered, or a fast swept one, at
+    /// the first static shape in its way ([`World::stop_at_static_shapes`]).
     pub(crate) fn refresh_body_proxies(&mut self, body_index: u32, dt: f32, sweep: bool) {
         if let Some(escaped) = self.refresh_boxes(body_index, dt, 0, true, sweep) {
             // A shape ended the step outside the fat box its pairs were found with.

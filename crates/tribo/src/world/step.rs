@@ -198,8 +198,12 @@ impl World {
         }
     }
 
-    /// Whether the pair with `key` has a contact with manifold points this step.
-    pub(crate) fn pair_has_points(&self, key: u64) -> bool {
+    /// Whether the pair with `key` has a contact with manifold points this step, `body`
+    /// being one of its bodies (its key list rules most pairs out before the pair table).
+    pub(crate) fn pair_has_points(&self, body: &Body, key: u64) -> bool {
+        if !self.pair_exists(body, key) {
+            return false;
+        }
         let contact = self
             .broad_phase
             .pairs

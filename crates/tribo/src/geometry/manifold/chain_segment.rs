@@ -24,7 +24,7 @@
 //! 0.01, and a normal may lean past the neighbour's by a sine of 0.01.
 
 use super::capsule_circle::capsule_circle_local;
-use super::polygon_polygon::{collide_polygons_local, LocalPoly};
+use super::polygon_polygon::{collide_polygons_local, incident_edge, LocalPoly};
 use super::{clip_incident_edge, closest_on_segment, feature_id, LocalManifold, Manifold, KIND_CLIP_REF_A};
 use crate::geometry::{Capsule, ChainSegment, Circle, Polygon};
 use crate::math::{Transform, Vec2};
@@ -220,15 +220,7 @@ fn chain_local(
 /// normal is most anti-parallel to the piece's normal), clipped to the piece's ends.
 fn clip_on_face(piece: &Piece, b: &LocalPoly, spec: f32) -> LocalManifold {
     let n = piece.normal1;
-    let mut inc = 0;
-    let mut min_dot = f32::MAX;
-    for j in 0..b.count {
-        let d = n.dot(b.n[j]);
-        if d < min_dot {
-            min_dot = d;
-            inc = j;
-        }
-    }
+    let inc = incident_edge(b, n);
     let (i21, i22) = (inc, (inc + 1) % b.count.max(1));
     let mut m = LocalManifold::new(n);
     if let Some((points, count)) =

@@ -100,6 +100,21 @@ fn max_separation(p1: &LocalPoly, p2: &LocalPoly) -> (usize, f32) {
     (best_edge, best)
 }
 
+/// The edge of `p` whose normal is most anti-parallel to the reference normal `n` (the
+/// incident edge of a reference face with normal `n`).
+pub(super) fn incident_edge(p: &LocalPoly, n: Vec2) -> usize {
+    let mut edge = 0;
+    let mut min_dot = f32::MAX;
+    for j in 0..p.count {
+        let d = n.dot(p.n[j]);
+        if d < min_dot {
+            min_dot = d;
+            edge = j;
+        }
+    }
+    edge
+}
+
 /// Polygon A against polygon B, both in A's frame. See the module documentation;
 /// `last_reference_b` is the face the pair's last manifold clipped against (step 2).
 pub(super) fn collide_polygons_local(
@@ -135,15 +150,7 @@ pub(super) fn collide_polygons_local(
     let (rf, inc, ref_edge) = if flip { (b, a, edge_b) } else { (a, b, edge_a) };
     let n = rf.n[ref_edge];
 
-    let mut inc_edge = 0;
-    let mut min_dot = f32::MAX;
-    for j in 0..inc.count {
-        let d = n.dot(inc.n[j]);
-        if d < min_dot {
-            min_dot = d;
-            inc_edge = j;
-        }
-    }
+    let inc_edge = incident_edge(inc, n);
 
     let i11 = ref_edge;
     let i12 = (ref_edge + 1) % rf.count;
