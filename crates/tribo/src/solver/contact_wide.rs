@@ -30,7 +30,7 @@ use super::contact_solver::{
     fresh_point_sticks, kinetic_energy_of, shift_cap2, ConstraintBodies, ConstraintPoint, ContactConstraint,
     ContactInput, StepSoftness,
 };
-use super::wide::{F4, LANES, M4, V4};
+use super::wide::{transpose, F4, LANES, M4, V4};
 use super::{StateCell, StateRead, StepContext};
 use crate::collision::contact::{Contact, FrictionState, PointState};
 use crate::math::Vec2;
@@ -152,33 +152,30 @@ struct WideBody {
     dq_s: F4,
 }
 
+/// Gathers four bodies: each state's two 16-byte halves (v, w, touched; dp, dq) as rows,
+/// transposed into lanes.
 #[inline(always)]
 fn gather<S: StateRead>(states: &[S], idx: &[u32; LANES]) -> WideBody {
-    let mut b = WideBody {
-        v: V4::default(),
-        w: F4::ZERO,
-        touched: F4::ZERO,
-        dp: V4::default(),
-        dq_s: F4::ZERO,
-    };
-    for l in 0..LANES {
-        let s = states[idx[l] as usize].get();
-        b.v.x.0[l] = s.v.x;
-        b.v.y.0[l] = s.v.y;
-        b.w.0[l] = s.w;
-        b.touched.0[l] = s.touched;
-        b.dp.x.0[l] = s.dp.x;
-        b.dp.y.0[l] = s.dp.y;
-        b.dq_s.0[l] = s.dq.s;
+    let s = idx.map(|i| states[i as usize].rows());
+    let [vx, vy, w, touched] = transpose(s.map(|r| r[0]));
+    let [dpx, dpy, _, dq_s] = transpose(s.map(|r| r[1]));
+    WideBody {
+        v: V4 { x: vx, y: vy },
+        w,
+        touched,
+        dp: V4 { x: dpx, y: dpy },
+        dq_s,
     }
-    b
 }
 
+/// Writes the velocities of the lanes' dynamic bodies back (the transpose of [`gather`]'s
+/// first half).
 #[inline(always)]
 fn scatter<S: StateCell>(states: &[S], idx: &[u32; LANES], write: &[bool; LANES], b: &WideBody) {
+    let rows = transpose([b.v.x, b.v.y, b.w, b.touched]);
     for l in 0..LANES {
         if write[l] {
-            states[idx[l] as usize].set_velocity(Vec2::new(b.v.x.0[l], b.v.y.0[l]), b.w.0[l], b.touched.0[l]);
+            states[idx[l] as usize].set_velocity_row(rows[l]);
         }
     }
 }

@@ -32,6 +32,7 @@ pub(crate) use softness::Softness;
 
 /// Velocity and accumulated motion of one awake body during a step (32 bytes, hot).
 #[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(16))]
 pub(crate) struct BodyState {
     /// Linear velocity of the centre of mass [m/s].
     pub v: Vec2,
@@ -47,8 +48,9 @@ pub(crate) struct BodyState {
 }
 
 /// A body's [`BodyState`] shared by the worker threads of a step: plain memory, read and
-/// written without atomics (one of the crate's three `unsafe` sites; the others are
-/// [`prefetch`] and the SSE intrinsics of [`wide`]).
+/// written without atomics (one of the crate's four `unsafe` sites; the others are
+/// [`prefetch`], the SSE intrinsics of [`wide`] and the row access of [`rows_at`] and
+/// [`write_velocity_row`]).
 ///
 /// Why it is race-free — the contract every user of [`StateCell`] for `SharedState` keeps:
 /// - a constraint pass runs colour by colour, and the constraints of one colour share no
@@ -87,12 +89,61 @@ unsafe impl Sync for SharedState {}
 /// code is generic over it: the physics is written once.
 pub(crate) trait StateRead {
     fn get(&self) -> BodyState;
+    /// The state as two rows of four lanes: (v.x, v.y, w, touched), (dp.x, dp.y, dq.c, dq.s).
+    fn rows(&self) -> [wide::F4; 2];
 }
+
+/// The rows of [`StateRead::rows`] read straight from a state's memory (two 16-byte loads).
+///
+/// The wide solver gathers four bodies by loading these rows and transposing them
+/// (Box2D v3's `b2GatherBodies` does the same): built field by field from a copied
+/// state, LLVM turned the transpose back into 28 single-lane loads and inserts per
+/// gather, and writing the velocity row as an `F4` became four scalar stores, which the
+/// next 16-byte load of that body could not forward from (large_pyramid: 6.3 → 6.09 G
+/// instructions in 100 steps, ~5 % per step in six alternations).
+#[inline(always)]
+#[allow(unsafe_code)]
+fn rows_at(p: *const BodyState) -> [wide::F4; 2] {
+    // SAFETY: `p` points to a live, aligned BodyState no thread writes now (every caller
+    // passes its own reference's address); BodyState is repr(C), 16-aligned and is eight
+    // f32 in the order of the rows (checked below), so it reads as two F4.
+    unsafe { *(p as *const [wide::F4; 2]) }
+}
+/// Writes the first row of [`StateRead::rows`] into a state's memory (one 16-byte store).
+#[inline(always)]
+#[allow(unsafe_code)]
+fn write_velocity_row(p: *mut BodyState, row: wide::F4) {
+    // SAFETY: `p` points to a live, aligned BodyState only this thread touches now (the
+    // caller's own cell, see [`SharedState`]'s contract); its first 16 bytes are v, w and
+    // touched as f32 (checked below).
+    unsafe {
+        // One vector store (storing the F4 array is four scalar stores after LLVM's
+        // scalar replacement).
+        #[cfg(target_arch = "x86_64")]
+        core::arch::x86_64::_mm_store_ps(p as *mut f32, core::arch::x86_64::_mm_setr_ps(row.0[0], row.0[1], row.0[2], row.0[3]));
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            *(p as *mut wide::F4) = row;
+        }
+    }
+}
+const _: () = {
+    assert!(core::mem::size_of::<BodyState>() == 32);
+    assert!(core::mem::offset_of!(BodyState, v) == 0);
+    assert!(core::mem::offset_of!(BodyState, w) == 8);
+    assert!(core::mem::offset_of!(BodyState, touched) == 12);
+    assert!(core::mem::offset_of!(BodyState, dp) == 16);
+    assert!(core::mem::offset_of!(BodyState, dq) == 24);
+};
 
 impl StateRead for BodyState {
     #[inline(always)]
     fn get(&self) -> BodyState {
         *self
+    }
+    #[inline(always)]
+    fn rows(&self) -> [wide::F4; 2] {
+        rows_at(self)
     }
 }
 
@@ -101,12 +152,20 @@ impl StateRead for core::cell::Cell<BodyState> {
     fn get(&self) -> BodyState {
         core::cell::Cell::get(self)
     }
+    #[inline(always)]
+    fn rows(&self) -> [wide::F4; 2] {
+        rows_at(self.as_ptr())
+    }
 }
 
 impl StateRead for SharedState {
     #[inline(always)]
     fn get(&self) -> BodyState {
         self.load()
+    }
+    #[inline(always)]
+    fn rows(&self) -> [wide::F4; 2] {
+        rows_at(self.0.get())
     }
 }
 
@@ -115,6 +174,9 @@ pub(crate) trait StateCell: StateRead + Clone + Send {
     fn set(&self, s: BodyState);
     /// Writes only what a constraint pass changes.
     fn set_velocity(&self, v: Vec2, w: f32, touched: f32);
+    /// [`StateCell::set_velocity`] from the first row of [`StateRead::rows`] (v.x, v.y, w,
+    /// touched): one 16-byte store.
+    fn set_velocity_row(&self, row: wide::F4);
     /// Calls `f(i, &mut items[i], states)` for every item; split between threads for
     /// shared states (chunks of at least `min_len`). `f` may only write its item and the
     /// states of bodies no other item touches.
@@ -150,6 +212,10 @@ impl StateCell for core::cell::Cell<BodyState> {
         s.w = w;
         s.touched = touched;
         core::cell::Cell::set(self, s);
+    }
+    #[inline(always)]
+    fn set_velocity_row(&self, row: wide::F4) {
+        write_velocity_row(self.as_ptr(), row);
     }
     fn for_each_mut<T: Send>(
         states: &[Self],
@@ -190,6 +256,10 @@ impl StateCell for SharedState {
     #[inline(always)]
     fn set_velocity(&self, v: Vec2, w: f32, touched: f32) {
         self.store_velocity(v, w, touched);
+    }
+    #[inline(always)]
+    fn set_velocity_row(&self, row: wide::F4) {
+        write_velocity_row(self.0.get(), row);
     }
     fn for_each_mut<T: Send>(
         states: &[Self],

@@ -70,6 +70,10 @@ mod sse {
         _mm_cmpge_ps(a: __m128, b: __m128) -> __m128;
         _mm_cmplt_ps(a: __m128, b: __m128) -> __m128;
         _mm_movemask_ps(a: __m128) -> i32;
+        _mm_unpacklo_ps(a: __m128, b: __m128) -> __m128;
+        _mm_unpackhi_ps(a: __m128, b: __m128) -> __m128;
+        _mm_movelh_ps(a: __m128, b: __m128) -> __m128;
+        _mm_movehl_ps(a: __m128, b: __m128) -> __m128;
     }
 
     /// Lane `L` of `v` moved to lane 0.
@@ -219,6 +223,28 @@ impl F4 {
             M4(lanes!(|i| mask(self.0[i] < o.0[i])))
         )
     }
+}
+
+/// The 4×4 transpose: lane `j` of output `i` is lane `i` of input `j` (turns four bodies'
+/// 16-byte rows into four lanes of each field and back; `_MM_TRANSPOSE4_PS`, eight
+/// shuffles instead of sixteen single-lane moves).
+#[inline(always)]
+pub(crate) fn transpose(rows: [F4; LANES]) -> [F4; LANES] {
+    simd!(
+        {
+            let [r0, r1, r2, r3] = rows.map(sse::f);
+            let (t0, t1) = (_mm_unpacklo_ps(r0, r1), _mm_unpacklo_ps(r2, r3));
+            let (t2, t3) = (_mm_unpackhi_ps(r0, r1), _mm_unpackhi_ps(r2, r3));
+            [
+                _mm_movelh_ps(t0, t1),
+                _mm_movehl_ps(t1, t0),
+                _mm_movelh_ps(t2, t3),
+                _mm_movehl_ps(t3, t2),
+            ]
+            .map(sse::to_f)
+        },
+        core::array::from_fn(|i| F4(core::array::from_fn(|j| rows[j].0[i])))
+    )
 }
 
 #[inline(always)]
@@ -440,5 +466,11 @@ mod tests {
         assert_eq!(m.to_unit().0, [1.0, 0.0, 0.0, 1.0]);
         assert_eq!((!m & a.ge(b)).0, [0, 0, u32::MAX, 0]);
         assert!(!m.all() && (m | !m).all());
+        let rows = [a, b, a + b, a * b];
+        let cols = transpose(rows);
+        for (i, col) in cols.iter().enumerate() {
+            assert_eq!(col.0, [a.0[i], b.0[i], (a + b).0[i], (a * b).0[i]]);
+        }
+        assert_eq!(transpose(cols), rows);
     }
 }
