@@ -63,6 +63,22 @@ impl LocalPoly {
         out
     }
 
+    /// `p` in its own frame (a copy: [`LocalPoly::from_polygon`] with the identity
+    /// would still do every multiplication).
+    pub fn of_polygon(p: &Polygon) -> LocalPoly {
+        let mut out = LocalPoly {
+            v: [Vec2::ZERO; MAX_POLYGON_VERTICES],
+            n: [Vec2::ZERO; MAX_POLYGON_VERTICES],
+            count: p.count(),
+            radius: p.radius(),
+        };
+        for (i, (v, n)) in p.vertices().iter().zip(p.normals()).enumerate() {
+            out.v[i] = *v;
+            out.n[i] = *n;
+        }
+        out
+    }
+
     /// The segment `p1`–`p2` (already in the target frame) grown by `radius`: vertices
     /// `[p1, p2]`, edge 0 is `p1 → p2` with normal `right_perp`, edge 1 is `p2 → p1`.
     pub fn from_segment(p1: Vec2, p2: Vec2, radius: f32) -> LocalPoly {
@@ -82,16 +98,29 @@ impl LocalPoly {
 }
 
 /// Edge of `p1` with the largest separation of `p2` from it, and that separation [m].
+///
+/// For each edge the separations of all of `p2`'s vertices are computed as one array
+/// (`p2` padded with its first vertex, which changes no minimum) and reduced by a tree of
+/// plain comparisons: straight-line code the compiler turns into SIMD, where a loop of
+/// `f32::min` (NaN-aware: five instructions per vertex) was 40 % of the polygon collision.
 fn max_separation(p1: &LocalPoly, p2: &LocalPoly) -> (usize, f32) {
+    const N: usize = MAX_POLYGON_VERTICES;
+    let vertex = |j: usize| p2.v[if j < p2.count { j } else { 0 }];
+    let xs: [f32; N] = core::array::from_fn(|j| vertex(j).x);
+    let ys: [f32; N] = core::array::from_fn(|j| vertex(j).y);
+    let lesser = |a: f32, b: f32| if b < a { b } else { a };
     let mut best_edge = 0;
     let mut best = f32::MIN;
     for i in 0..p1.count {
-        let n = p1.n[i];
-        let v = p1.v[i];
-        let mut si = f32::MAX;
-        for j in 0..p2.count {
-            si = si.min(n.dot(p2.v[j] - v));
-        }
+        let (n, v) = (p1.n[i], p1.v[i]);
+        // n · (p2.v[j] − v), the same expression as `Vec2::dot`.
+        let d: [f32; N] = core::array::from_fn(|j| n.x * (xs[j] - v.x) + n.y * (ys[j] - v.y));
+        let si = if p2.count <= 4 {
+            lesser(lesser(d[0], d[1]), lesser(d[2], d[3]))
+        } else {
+            let half: [f32; 4] = core::array::from_fn(|j| lesser(d[j], d[j + 4]));
+            lesser(lesser(half[0], half[1]), lesser(half[2], half[3]))
+        };
         if si > best {
             best = si;
             best_edge = i;
@@ -224,7 +253,7 @@ pub(super) fn collide_polygons(
     spec: f32,
     last_reference_b: Option<bool>,
 ) -> (Manifold, f32) {
-    let la = LocalPoly::from_polygon(a, Transform::IDENTITY);
+    let la = LocalPoly::of_polygon(a);
     let lb = LocalPoly::from_polygon(b, xf_a.inv_mul(xf_b));
     collide_polygons_local(&la, &lb, spec, last_reference_b).to_world(xf_a, xf_b)
 }

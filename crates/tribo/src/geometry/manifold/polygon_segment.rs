@@ -15,7 +15,7 @@ pub(super) fn collide_polygon_segment(
     spec: f32,
 ) -> (Manifold, f32) {
     let rel = xf_a.inv_mul(xf_b);
-    let pa = LocalPoly::from_polygon(a, Transform::IDENTITY);
+    let pa = LocalPoly::of_polygon(a);
     let pb = LocalPoly::from_segment(rel.apply(b.point1), rel.apply(b.point2), 0.0);
     collide_polygons_local(&pa, &pb, spec, None).to_world(xf_a, xf_b)
 }
