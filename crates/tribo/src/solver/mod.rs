@@ -120,7 +120,10 @@ fn write_velocity_row(p: *mut BodyState, row: wide::F4) {
         // One vector store (storing the F4 array is four scalar stores after LLVM's
         // scalar replacement).
         #[cfg(target_arch = "x86_64")]
-        core::arch::x86_64::_mm_store_ps(p as *mut f32, core::arch::x86_64::_mm_setr_ps(row.0[0], row.0[1], row.0[2], row.0[3]));
+        core::arch::x86_64::_mm_store_ps(
+            p as *mut f32,
+            core::arch::x86_64::_mm_setr_ps(row.0[0], row.0[1], row.0[2], row.0[3]),
+        );
         #[cfg(not(target_arch = "x86_64"))]
         {
             *(p as *mut wide::F4) = row;
