@@ -79,15 +79,35 @@ pub(crate) struct Contact {
     pub material: MixedMaterial,
     pub shape_a: ShapeId,
     pub shape_b: ShapeId,
-    /// Where the manifold was last computed, for recycling it.
-    pub basis: RecycleBasis,
-    /// For a pair found apart: a lower bound [m] on its surfaces' distance at the poses of
-    /// `far` (0: none). See [`Contact::still_apart`].
-    pub far_bound: f32,
-    pub far: FarPoses,
+    /// What the last full collision left for the next steps to skip one.
+    pub memo: Memo,
 }
 
-/// The bodies' poses when [`Contact::far_bound`] was computed.
+const _: () = assert!(core::mem::size_of::<Contact>() == 320);
+
+/// What a contact keeps of its last full collision to skip the next: the recycling basis
+/// of a touching pair, or the distance bound of a pair found apart. A contact is one or
+/// the other, never both, so the two share their bytes: the record is five cache lines,
+/// not six (the narrow phase streams every awake contact each step).
+///
+/// `repr(u8)`: a tag of one byte leaves fewer spare values than `Contact::touching`, so
+/// `Option<Contact>` keeps its `None` in that first byte; with a wider tag the compiler put
+/// it here, in the fourth cache line, which every pass that only checks a slot then had to
+/// load (the impulse store took twice as long in large_pyramid).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(u8)]
+pub(crate) enum Memo {
+    /// Nothing to reuse.
+    #[default]
+    None,
+    /// Where the manifold was last computed (touching pairs; [`Contact::recycle`]).
+    Basis(RecycleBasis),
+    /// A pair found apart: a lower bound [m] (> 0) on its surfaces' distance at the poses
+    /// `poses` ([`Contact::still_apart`]).
+    Far { bound: f32, poses: FarPoses },
+}
+
+/// The bodies' poses when a pair's distance bound ([`Memo::Far`]) was computed.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct FarPoses {
     /// Origin of B minus origin of A [m].
@@ -158,7 +178,6 @@ impl Contact {
         let old_points = self.points;
         let (manifold, bound) = collide_bounded(geom_a, xf_a, geom_b, xf_b, speculative_distance, &old_manifold);
         self.manifold = manifold;
-        self.far_bound = bound;
         for i in 0..self.manifold.count {
             let id = self.manifold.points[i].id;
             let matched = (0..old_manifold.count).find(|&j| old_manifold.points[j].id == id);
@@ -179,24 +198,38 @@ impl Contact {
         for p in self.points.iter_mut().skip(self.manifold.count) {
             *p = PointState::default();
         }
-        if self.manifold.count == 0 {
-            self.rolling_impulse = 0.0;
-        }
         self.touching = self.manifold.count > 0;
-        self.basis = RecycleBasis::default();
+        if !self.touching {
+            self.rolling_impulse = 0.0;
+            self.memo = if bound > 0.0 {
+                Memo::Far {
+                    bound,
+                    poses: FarPoses {
+                        d: xf_b.p - xf_a.p,
+                        q_a: xf_a.q,
+                        q_b: xf_b.q,
+                    },
+                }
+            } else {
+                Memo::None
+            };
+            return false;
+        }
+        let mut basis = RecycleBasis::default();
         let n = self.manifold.normal;
         for i in 0..self.manifold.count {
             let mp = &self.manifold.points[i];
             let half = 0.5 * mp.separation * n;
             let (surface_a, surface_b) = (mp.point - half, mp.point + half);
-            self.basis.local_a[i] = xf_a.inv_apply(surface_a);
-            self.basis.local_b[i] = xf_b.inv_apply(surface_b);
-            self.basis.b_in_a[i] = xf_a.inv_apply(surface_b);
-            self.basis.a_in_b[i] = xf_b.inv_apply(surface_a);
+            basis.local_a[i] = xf_a.inv_apply(surface_a);
+            basis.local_b[i] = xf_b.inv_apply(surface_b);
+            basis.b_in_a[i] = xf_a.inv_apply(surface_b);
+            basis.a_in_b[i] = xf_b.inv_apply(surface_a);
         }
-        self.basis.rel_q = xf_a.q.inv_mul(xf_b.q);
-        self.basis.normal_a = xf_a.q.inv_rotate(n);
-        self.touching
+        basis.rel_q = xf_a.q.inv_mul(xf_b.q);
+        basis.normal_a = xf_a.q.inv_rotate(n);
+        self.memo = Memo::Basis(basis);
+        true
     }
 
     /// Whether a pair found apart is still too far apart for any manifold point within
@@ -209,13 +242,15 @@ impl Contact {
     /// (see `geometry::collide_bounded`).
     #[inline]
     pub fn still_apart(&self, d: Vec2, q_a: Rot, q_b: Rot, reach_a: f32, reach_b: f32, margin: f32) -> bool {
-        if self.touching || self.far_bound <= margin {
+        let Memo::Far { bound, poses: f } = &self.memo else {
+            return false;
+        };
+        if self.touching || *bound <= margin {
             return false;
         }
-        let f = &self.far;
         let turn = |q: Rot, q0: Rot| ((q.c - q0.c) * (q.c - q0.c) + (q.s - q0.s) * (q.s - q0.s)).sqrt();
         let closed = (d - f.d).length() + reach_a * turn(q_a, f.q_a) + reach_b * turn(q_b, f.q_b);
-        self.far_bound - closed > margin
+        *bound - closed > margin
     }
 
     /// What [`Contact::update`] leaves when the shapes are too far apart for any point:
@@ -225,7 +260,10 @@ impl Contact {
         self.points = [PointState::default(); MAX_MANIFOLD_POINTS];
         self.rolling_impulse = 0.0;
         self.touching = false;
-        self.basis = RecycleBasis::default();
+        // A distance bound stays true of its poses; a basis has nothing left to recycle.
+        if matches!(self.memo, Memo::Basis(_)) {
+            self.memo = Memo::None;
+        }
     }
 
     /// Reuses the manifold of a touching contact whose bodies moved less than
@@ -239,28 +277,31 @@ impl Contact {
     /// nothing) when the contact must be collided again.
     pub fn recycle(&mut self, xf_a: Transform, xf_b: Transform, extent: f32) -> bool {
         let count = self.manifold.count;
+        let Memo::Basis(basis) = &self.memo else {
+            return false;
+        };
         if count == 0 {
             return false;
         }
         let limit2 = RECYCLE_DISTANCE * RECYCLE_DISTANCE;
         let rel = xf_a.inv_mul(xf_b);
-        let turned = self.basis.rel_q.inv_mul(rel.q).s.abs() * extent;
+        let turned = basis.rel_q.inv_mul(rel.q).s.abs() * extent;
         if turned > RECYCLE_DISTANCE {
             return false;
         }
         let rel_ba = xf_b.inv_mul(xf_a);
         for i in 0..count {
-            let moved_b = rel.apply(self.basis.local_b[i]) - self.basis.b_in_a[i];
-            let moved_a = rel_ba.apply(self.basis.local_a[i]) - self.basis.a_in_b[i];
+            let moved_b = rel.apply(basis.local_b[i]) - basis.b_in_a[i];
+            let moved_a = rel_ba.apply(basis.local_a[i]) - basis.a_in_b[i];
             if moved_b.length_squared() > limit2 || moved_a.length_squared() > limit2 {
                 return false;
             }
         }
-        let n = xf_a.q.rotate(self.basis.normal_a);
+        let n = xf_a.q.rotate(basis.normal_a);
         self.manifold.normal = n;
         for i in 0..count {
-            let surface_a = xf_a.apply(self.basis.local_a[i]);
-            let surface_b = xf_b.apply(self.basis.local_b[i]);
+            let surface_a = xf_a.apply(basis.local_a[i]);
+            let surface_b = xf_b.apply(basis.local_b[i]);
             let mp = &mut self.manifold.points[i];
             mp.point = 0.5 * (surface_a + surface_b);
             mp.anchor_a = mp.point - xf_a.p;
@@ -303,9 +344,7 @@ pub(crate) fn blank_contact() -> Contact {
         rolling_radius: 0.0,
         rolling_impulse: 0.0,
         touching: false,
-        basis: RecycleBasis::default(),
-        far_bound: 0.0,
-        far: FarPoses::default(),
+        memo: Memo::None,
     }
 }
 
@@ -447,13 +486,6 @@ mod tests {
             if c.update(&a_shape, xf_a, &b_shape, xf_b, margin) {
                 touched = true;
                 break;
-            }
-            if c.far_bound > 0.0 {
-                c.far = FarPoses {
-                    d,
-                    q_a: xf_a.q,
-                    q_b: xf_b.q,
-                };
             }
         }
         assert!(touched, "the boxes never touched");

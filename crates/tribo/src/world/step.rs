@@ -8,7 +8,7 @@
 
 use super::{ContactBeginEvent, ContactEndEvent, ShapeBounds, Stopwatch, World};
 use crate::collision::broad_phase::{MOVING_TREE, STATIC_TREE};
-use crate::collision::contact::{pair_key, Contact, FarPoses, NarrowOutcome, PointState, NO_COLOUR};
+use crate::collision::contact::{pair_key, Contact, Memo, NarrowOutcome, PointState, NO_COLOUR};
 use crate::dynamics::body::Body;
 use crate::dynamics::shape::ShapeRecord;
 use crate::dynamics::{mix, BodyType};
@@ -234,9 +234,7 @@ impl World {
             rolling_impulse: 0.0,
             touching: false,
             colour: NO_COLOUR,
-            basis: Default::default(),
-            far_bound: 0.0,
-            far: Default::default(),
+            memo: Memo::None,
         };
         let (body_a, body_b) = (contact.body_a, contact.body_b);
         let ci = match self.contact_free.pop() {
@@ -889,13 +887,6 @@ fn narrow_phase(
             (Some(sa), Some(sb)) => c.update(&sa.geometry, ba.xf, &sb.geometry, bb.xf, margin),
             _ => false,
         };
-    if !now && c.far_bound > 0.0 {
-        c.far = FarPoses {
-            d,
-            q_a: ba.xf.q,
-            q_b: bb.xf.q,
-        };
-    }
     NarrowOutcome::Updated {
         touching: now,
         changed: now != was,
