@@ -109,6 +109,7 @@ fn rows_at(p: *const BodyState) -> [wide::F4; 2] {
     // f32 in the order of the rows (checked below), so it reads as two F4.
     unsafe { *(p as *const [wide::F4; 2]) }
 }
+
 /// Writes the first row of [`StateRead::rows`] into a state's memory (one 16-byte store).
 #[inline(always)]
 #[allow(unsafe_code)]
@@ -137,6 +138,9 @@ const _: () = {
     assert!(core::mem::offset_of!(BodyState, touched) == 12);
     assert!(core::mem::offset_of!(BodyState, dp) == 16);
     assert!(core::mem::offset_of!(BodyState, dq) == 24);
+    // The fields inside (Rust may order a plain struct's fields as it likes).
+    assert!(core::mem::offset_of!(Vec2, x) == 0 && core::mem::offset_of!(Vec2, y) == 4);
+    assert!(core::mem::offset_of!(Rot, c) == 0 && core::mem::offset_of!(Rot, s) == 4);
 };
 
 impl StateRead for BodyState {
