@@ -72,15 +72,17 @@ pub(crate) struct Candidate {
 }
 
 impl Candidate {
-    pub fn new(contact: u32, colour: u8, bodies: ConstraintBodies, input: ContactInput) -> Candidate {
-        Candidate {
-            contact,
-            fast: fast_first(&input),
-            colour,
-            fresh: input.points[..(input.count as usize).min(2)].iter().any(|p| p.fresh),
-            bodies,
-            input,
-        }
+    /// Writes the candidate of contact `contact` (record `c`) in place: the 160-byte
+    /// candidate built on the stack and then copied into its slot cost a `memcpy` per
+    /// touching contact on top of the writes (large_pyramid: ~2 % of the step).
+    pub fn fill(&mut self, contact: u32, colour: u8, bodies: ConstraintBodies, c: &Contact) {
+        self.contact = contact;
+        self.colour = colour;
+        self.bodies = bodies;
+        self.input.fill(c);
+        let input = &self.input;
+        self.fast = fast_first(input);
+        self.fresh = input.points[..input.count.min(2)].iter().any(|p| p.fresh);
     }
 
     /// A placeholder for a contact that is not solved this step.

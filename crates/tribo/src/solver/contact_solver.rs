@@ -201,33 +201,32 @@ impl ContactInput {
         rolling_impulse: 0.0,
     };
 
-    pub fn new(c: &Contact) -> ContactInput {
-        let mut input = ContactInput {
-            normal: c.manifold.normal,
-            count: c.manifold.count.min(2),
-            points: [InputPoint::default(); 2],
-            mu_s: c.material.friction_static,
-            mu_d: c.material.friction_dynamic,
-            restitution: c.material.restitution,
-            restitution_threshold: c.material.restitution_threshold,
-            rolling_resistance: c.material.rolling_resistance * c.rolling_radius,
-            tangent_speed: c.material.tangent_speed,
-            rolling_impulse: c.rolling_impulse,
-        };
-        for i in 0..input.count {
-            let (mp, ps) = (&c.manifold.points[i], &c.points[i]);
-            input.points[i] = InputPoint {
-                point: mp.point,
-                separation: mp.separation,
-                normal_impulse: ps.normal_impulse,
-                tangent_impulse: ps.tangent_impulse,
-                preload: ps.preload,
-                drift: ps.drift,
-                stick: ps.state == FrictionState::Stick,
-                fresh: ps.fresh,
+    /// Writes what building a constraint reads of contact `c` in place (no copy).
+    pub fn fill(&mut self, c: &Contact) {
+        self.normal = c.manifold.normal;
+        self.count = c.manifold.count.min(2);
+        self.mu_s = c.material.friction_static;
+        self.mu_d = c.material.friction_dynamic;
+        self.restitution = c.material.restitution;
+        self.restitution_threshold = c.material.restitution_threshold;
+        self.rolling_resistance = c.material.rolling_resistance * c.rolling_radius;
+        self.tangent_speed = c.material.tangent_speed;
+        self.rolling_impulse = c.rolling_impulse;
+        for (i, out) in self.points.iter_mut().enumerate() {
+            *out = match (c.manifold.points.get(i), c.points.get(i)) {
+                (Some(mp), Some(ps)) if i < self.count => InputPoint {
+                    point: mp.point,
+                    separation: mp.separation,
+                    normal_impulse: ps.normal_impulse,
+                    tangent_impulse: ps.tangent_impulse,
+                    preload: ps.preload,
+                    drift: ps.drift,
+                    stick: ps.state == FrictionState::Stick,
+                    fresh: ps.fresh,
+                },
+                _ => InputPoint::default(),
             };
         }
-        input
     }
 }
 

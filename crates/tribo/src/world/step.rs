@@ -16,7 +16,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::{Candidate, Candidates};
-use crate::solver::contact_solver::{ConstraintBodies, ContactInput};
+use crate::solver::contact_solver::ConstraintBodies;
 use crate::solver::{
     for_each_mut, for_each_mut3, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints, StepContext,
 };
@@ -281,13 +281,7 @@ impl World {
         let update = |ci: usize, c: &mut Contact, cand: &mut Candidate, out: &mut (NarrowOutcome, bool)| {
             let outcome = narrow_phase(c, solver_bodies, bounds, shapes, dt);
             let solvable = matches!(outcome, NarrowOutcome::Updated { touching: true, .. })
-                && match candidate(ci as u32, c, solver_bodies) {
-                    Some(x) => {
-                        *cand = x;
-                        true
-                    }
-                    None => false,
-                };
+                && candidate(ci as u32, c, solver_bodies, cand);
             *out = (outcome, solvable);
         };
         let mostly_awake = self.active_body_flags(&mut flags);
@@ -396,11 +390,10 @@ impl World {
             solvable.clear();
             for &ci in &touching {
                 if let Some(Some(c)) = self.contacts.get(ci as usize) {
-                    if let (Some(x), Some(slot)) =
-                        (candidate(ci, c, &self.solver_bodies), candidates.get_mut(ci as usize))
-                    {
-                        *slot = x;
-                        solvable.push(ci);
+                    if let Some(slot) = candidates.get_mut(ci as usize) {
+                        if candidate(ci, c, &self.solver_bodies, slot) {
+                            solvable.push(ci);
+                        }
                     }
                 }
             }
@@ -794,18 +787,20 @@ const SHORT_CONTACT_LIST: usize = 16;
 const PAIR_PREFETCH: usize = 8;
 
 /// The solver's input of a touching contact with an awake dynamic side (`None` otherwise).
-fn candidate(ci: u32, c: &Contact, solver_bodies: &[SolverBody]) -> Option<Candidate> {
+fn candidate(ci: u32, c: &Contact, solver_bodies: &[SolverBody], out: &mut Candidate) -> bool {
     if !c.touching {
-        return None;
+        return false;
     }
-    let (ba, bb) = (
-        solver_bodies.get(c.body_a as usize)?,
-        solver_bodies.get(c.body_b as usize)?,
-    );
+    let (Some(ba), Some(bb)) = (
+        solver_bodies.get(c.body_a as usize),
+        solver_bodies.get(c.body_b as usize),
+    ) else {
+        return false;
+    };
     if !ba.awake_dynamic && !bb.awake_dynamic {
-        return None;
+        return false;
     }
-    Some(Candidate::new(
+    out.fill(
         ci,
         c.colour,
         ConstraintBodies {
@@ -818,8 +813,9 @@ fn candidate(ci: u32, c: &Contact, solver_bodies: &[SolverBody]) -> Option<Candi
             center_a: ba.center,
             center_b: bb.center,
         },
-        ContactInput::new(c),
-    ))
+        c,
+    );
+    true
 }
 
 /// Updates one contact's manifold (recycled when its bodies barely moved); reads only the
