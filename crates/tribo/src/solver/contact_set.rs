@@ -52,45 +52,46 @@ enum Slot {
     Overflow(u32),
 }
 
-/// One touching contact to solve this step.
+/// One touching contact to solve this step: what building its constraint reads.
 ///
-/// `repr(C)`, 16-byte aligned, 160 bytes: what the colouring pass reads (contact, the
-/// fast-first flag, body indices and inverse masses) is the first 32 bytes, never split
-/// between two cache lines; the solver input follows.
+/// `repr(C)`, 16-byte aligned, 160 bytes (contact and bodies, then the solver input). What
+/// the colouring reads is a [`ColourKey`], in an array of its own.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(16))]
 pub(crate) struct Candidate {
     pub contact: u32,
-    /// [`fast_first`] of the input.
-    fast: bool,
-    /// The colour the contact had when last solved ([`NO_COLOUR`]: none), tried first.
-    colour: u8,
-    /// A point is new this step (the warm-start estimate looks at the constraint).
-    fresh: bool,
     pub bodies: ConstraintBodies,
     pub input: ContactInput,
 }
 
 impl Candidate {
-    /// Writes the candidate of contact `contact` (record `c`) in place: the 160-byte
-    /// candidate built on the stack and then copied into its slot cost a `memcpy` per
-    /// touching contact on top of the writes (large_pyramid: ~2 % of the step).
-    pub fn fill(&mut self, contact: u32, colour: u8, bodies: ConstraintBodies, c: &Contact) {
+    /// Writes the candidate of contact `contact` (record `c`) in place, and its colouring
+    /// key into `key` (`colour`: the contact's colour last step): the 160-byte candidate
+    /// built on the stack and then copied into its slot cost a `memcpy` per touching
+    /// contact on top of the writes (large_pyramid: ~2 % of the step).
+    pub fn fill(&mut self, contact: u32, colour: u8, bodies: ConstraintBodies, c: &Contact, key: &mut ColourKey) {
         self.contact = contact;
-        self.colour = colour;
         self.bodies = bodies;
         self.input.fill(c);
         let input = &self.input;
-        self.fast = fast_first(input);
-        self.fresh = input.points[..input.count.min(2)].iter().any(|p| p.fresh);
+        let b = &self.bodies;
+        let fresh = input.points[..input.count.min(2)].iter().any(|p| p.fresh);
+        let flag = |on: bool, bit: u8| if on { bit } else { 0 };
+        *key = ColourKey {
+            index_a: b.index_a,
+            index_b: b.index_b,
+            colour,
+            flags: flag(fast_first(input), FAST)
+                | flag(fresh, FRESH)
+                | flag(b.index_a != 0 && dynamic_side(b.inv_mass_a, b.inv_i_a), KEY_DYNAMIC_A)
+                | flag(b.index_b != 0 && dynamic_side(b.inv_mass_b, b.inv_i_b), KEY_DYNAMIC_B)
+                | flag(mass_ratio(b).is_some(), KEY_RATIO),
+        };
     }
 
     /// A placeholder for a contact that is not solved this step.
     pub const SKIP: Candidate = Candidate {
         contact: u32::MAX,
-        fast: false,
-        colour: NO_COLOUR,
-        fresh: false,
         bodies: ConstraintBodies {
             index_a: 0,
             index_b: 0,
@@ -105,17 +106,56 @@ impl Candidate {
     };
 }
 
-/// The candidates of a step: `slots` indexed by contact, `list` the contacts to solve (in
-/// contact order); candidate `i` is `slots[list[i]]`.
+/// What the colouring pass reads of a candidate: 12 bytes, in an array of its own, so the
+/// serial colouring streams these instead of one cache line of each 160-byte candidate
+/// (large_pyramid: 15 000 lines a step).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct ColourKey {
+    index_a: u32,
+    index_b: u32,
+    /// The colour the contact had when last solved ([`NO_COLOUR`]: none), tried first.
+    colour: u8,
+    /// [`FAST`], [`FRESH`], [`KEY_DYNAMIC_A`], [`KEY_DYNAMIC_B`], [`KEY_RATIO`].
+    flags: u8,
+}
+
+/// Flag of a [`ColourKey`]: side A is a moving body (takes a colour).
+const KEY_DYNAMIC_A: u8 = 0x01;
+/// Flag of a [`ColourKey`]: side B is a moving body.
+const KEY_DYNAMIC_B: u8 = 0x02;
+/// Flag of a [`ColourKey`]: one body is more than [`MASS_RATIO_GROUP`] times heavier than
+/// the other (the colouring then reads the whole candidate, see [`mass_ratio`]).
+const KEY_RATIO: u8 = 0x04;
+
+/// For two bodies with mass, one more than [`MASS_RATIO_GROUP`] times heavier than the
+/// other: (mass ratio, light body, heavy body, whether A is the light one).
+#[inline]
+fn mass_ratio(b: &ConstraintBodies) -> Option<(f32, u32, u32, bool)> {
+    if !(b.inv_mass_a > 0.0 && b.inv_mass_b > 0.0) {
+        return None;
+    }
+    // The light body, and the direction from it to the heavy one (the normal points from A
+    // to B).
+    let out = if b.inv_mass_a > b.inv_mass_b {
+        (b.inv_mass_a / b.inv_mass_b, b.index_a, b.index_b, true)
+    } else {
+        (b.inv_mass_b / b.inv_mass_a, b.index_b, b.index_a, false)
+    };
+    (out.0 > MASS_RATIO_GROUP).then_some(out)
+}
+
+/// The candidates of a step: `slots` (and their colouring `keys`) indexed by contact,
+/// `list` the contacts to solve (in contact order); candidate `i` is `slots[list[i]]`.
 #[derive(Clone, Copy)]
 pub(crate) struct Candidates<'a> {
     slots: &'a [Candidate],
+    keys: &'a [ColourKey],
     list: &'a [u32],
 }
 
 impl<'a> Candidates<'a> {
-    pub fn new(slots: &'a [Candidate], list: &'a [u32]) -> Candidates<'a> {
-        Candidates { slots, list }
+    pub fn new(slots: &'a [Candidate], keys: &'a [ColourKey], list: &'a [u32]) -> Candidates<'a> {
+        Candidates { slots, keys, list }
     }
 
     /// The `i`-th candidate.
@@ -127,6 +167,13 @@ impl<'a> Candidates<'a> {
     /// The candidates in order.
     pub fn iter(&self) -> impl Iterator<Item = &'a Candidate> + '_ {
         self.list.iter().filter_map(|&ci| self.slots.get(ci as usize))
+    }
+
+    /// The candidates' contacts and colouring keys, in order.
+    fn keys(&self) -> impl Iterator<Item = (u32, &'a ColourKey)> + '_ {
+        self.list
+            .iter()
+            .filter_map(|&ci| Some((ci, self.keys.get(ci as usize)?)))
     }
 }
 
@@ -277,30 +324,21 @@ impl ContactSolver {
         let mut light: Vec<(u32, u32)> = Vec::new(); // (light body state, sweeps)
         self.contact_of.clear();
         self.contacts_ascend = true;
-        for cand in candidates.iter() {
-            if self.contact_of.last().is_some_and(|&last| last >= cand.contact) {
+        for (i, (contact, key)) in candidates.keys().enumerate() {
+            if self.contact_of.last().is_some_and(|&last| last >= contact) {
                 self.contacts_ascend = false;
             }
-            self.contact_of.push(cand.contact);
-            let b = &cand.bodies;
-            if b.inv_mass_a > 0.0 && b.inv_mass_b > 0.0 {
-                // The light body, and the direction from it to the heavy one (the normal
-                // points from A to B).
-                let (ratio, body, heavy, a_is_light) = if b.inv_mass_a > b.inv_mass_b {
-                    (b.inv_mass_a / b.inv_mass_b, b.index_a, b.index_b, true)
-                } else {
-                    (b.inv_mass_b / b.inv_mass_a, b.index_b, b.index_a, false)
-                };
-                // Only where the heavy body rests on the light one: it lies above it against
-                // gravity (a heavy container holding light bodies, Box2D's tumbler drum at
-                // 64 000 times its boxes' mass, carries them; they do not carry it), and it
-                // has no joint (a motor may press it on the light body with any torque:
-                // Box2D's spinner rotor, squeezing bodies against the wall with unbounded
-                // torque, made the extra sweeps pile up impulses without bound until the
-                // states overflowed). The normal (in the candidate's second cache line) is
-                // read only for such a pair.
-                if ratio > MASS_RATIO_GROUP {
-                    let n = cand.input.normal;
+            self.contact_of.push(contact);
+            // Only where the heavy body rests on the light one: it lies above it against
+            // gravity (a heavy container holding light bodies, Box2D's tumbler drum at
+            // 64 000 times its boxes' mass, carries them; they do not carry it), and it has
+            // no joint (a motor may press it on the light body with any torque: Box2D's
+            // spinner rotor, squeezing bodies against the wall with unbounded torque, made
+            // the extra sweeps pile up impulses without bound until the states overflowed).
+            // The candidate (masses, normal) is read only for such a pair.
+            if key.flags & KEY_RATIO != 0 {
+                if let Some((ratio, body, heavy, a_is_light)) = candidates.get(i).and_then(|c| mass_ratio(&c.bodies)) {
+                    let n = candidates.get(i).map_or(Vec2::ZERO, |c| c.input.normal);
                     let to_heavy = if a_is_light { n } else { -n };
                     let carries = self.up == Vec2::ZERO || to_heavy.dot(self.up) > MIN_CARRY_COSINE;
                     let free = sims.get(heavy as usize).is_some_and(|s| !s.jointed);
@@ -309,12 +347,9 @@ impl ContactSolver {
                     }
                 }
             }
-            let (da, db) = (
-                b.index_a != 0 && dynamic_side(b.inv_mass_a, b.inv_i_a),
-                b.index_b != 0 && dynamic_side(b.inv_mass_b, b.inv_i_b),
-            );
-            let busy = (if da { self.used[b.index_a as usize] } else { 0 })
-                | (if db { self.used[b.index_b as usize] } else { 0 });
+            let (da, db) = (key.flags & KEY_DYNAMIC_A != 0, key.flags & KEY_DYNAMIC_B != 0);
+            let busy = (if da { self.used[key.index_a as usize] } else { 0 })
+                | (if db { self.used[key.index_b as usize] } else { 0 });
             // The colour of the last step when it is still free (a pile keeps its layout:
             // `World::reorder_contacts`), else the lowest free colour below DYNAMIC_COLORS, or the
             // highest free one from 1 up (bit scans of the free colours).
@@ -323,9 +358,9 @@ impl ContactSolver {
             } else {
                 STATIC_COLOR_BITS
             };
-            let kept = 1u32.checked_shl(cand.colour as u32).unwrap_or(0) & open & !busy;
+            let kept = 1u32.checked_shl(key.colour as u32).unwrap_or(0) & open & !busy;
             let colour = if kept != 0 {
-                Some(cand.colour as usize)
+                Some(key.colour as usize)
             } else if da && db {
                 let free = !busy & DYNAMIC_COLOR_BITS;
                 (free != 0).then(|| free.trailing_zeros() as usize)
@@ -336,16 +371,14 @@ impl ContactSolver {
             match colour {
                 Some(k) => {
                     if da {
-                        self.used[b.index_a as usize] |= 1 << k;
+                        self.used[key.index_a as usize] |= 1 << k;
                     }
                     if db {
-                        self.used[b.index_b as usize] |= 1 << k;
+                        self.used[key.index_b as usize] |= 1 << k;
                     }
                     counts[k] += 1;
-                    let fast = cand.fast;
-                    fast_counts[k] += fast as u32;
-                    self.colours
-                        .push(k as u8 | if fast { FAST } else { 0 } | if cand.fresh { FRESH } else { 0 });
+                    fast_counts[k] += (key.flags & FAST != 0) as u32;
+                    self.colours.push(k as u8 | (key.flags & (FAST | FRESH)));
                 }
                 None => self.colours.push(OVERFLOW),
             }
@@ -385,7 +418,8 @@ impl ContactSolver {
                 let Some(cand) = candidates.get(i) else { continue };
                 let b = &cand.bodies;
                 let cc = build_constraint(cand.contact, &cand.input, b, self.up, &soft, ctx, states);
-                if cand.fresh {
+                let input = &cand.input;
+                if input.points[..input.count.min(2)].iter().any(|p| p.fresh) {
                     self.fresh.push(Slot::Overflow(self.overflow.len() as u32));
                 }
                 self.overflow.push(cc);

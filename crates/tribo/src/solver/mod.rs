@@ -521,6 +521,36 @@ pub(crate) fn for_each_mut<T: Send>(parallel: bool, items: &mut [T], min_len: us
     }
 }
 
+/// [`for_each_mut3`] over four slices.
+pub(crate) fn for_each_mut4<A: Send, B: Send, C: Send, D: Send>(
+    parallel: bool,
+    slices: (&mut [A], &mut [B], &mut [C], &mut [D]),
+    min_len: usize,
+    f: impl Fn(usize, &mut A, &mut B, &mut C, &mut D) + Sync,
+) {
+    let (a, b, c, d) = slices;
+    if parallel {
+        use rayon::prelude::*;
+        a.par_iter_mut()
+            .zip(b.par_iter_mut())
+            .zip(c.par_iter_mut())
+            .zip(d.par_iter_mut())
+            .enumerate()
+            .with_min_len(min_len)
+            .for_each(|(i, (((w, x), y), z))| f(i, w, x, y, z));
+    } else {
+        for (i, (((w, x), y), z)) in a
+            .iter_mut()
+            .zip(b.iter_mut())
+            .zip(c.iter_mut())
+            .zip(d.iter_mut())
+            .enumerate()
+        {
+            f(i, w, x, y, z);
+        }
+    }
+}
+
 /// Calls `f(i, &mut a[i], &mut b[i], &mut c[i])` for every index, split between the pool's
 /// threads when `parallel` (see [`for_each_mut`]).
 pub(crate) fn for_each_mut3<A: Send, B: Send, C: Send>(

@@ -28,7 +28,7 @@ use crate::dynamics::{BodyDef, BodyType, Filter, Material, ShapeDef};
 use crate::error::{check_finite, check_non_negative, check_positive, check_vec, Error, Result};
 use crate::geometry::{Shape, LINEAR_SLOP, SPECULATIVE_DISTANCE};
 use crate::math::{Aabb, Transform, Vec2};
-use crate::solver::contact_set::{Candidate, ContactSolver};
+use crate::solver::contact_set::{Candidate, ColourKey, ContactSolver};
 use crate::solver::{BodySim, BodyState};
 
 /// World settings. Every field has a default (listed on the field) that matches Box2D v3
@@ -194,6 +194,8 @@ pub struct World {
     /// The solver's input of each contact slot, written by the narrow phase for the
     /// touching contacts with an awake dynamic side (`solver_contacts` lists them).
     pub(crate) candidates: Vec<Candidate>,
+    /// What the colouring reads of each candidate (indexed by contact, like `candidates`).
+    pub(crate) colour_keys: Vec<ColourKey>,
     /// The narrow phase's verdict on each contact slot it visited this step, and whether
     /// the contact has a candidate (dense: the serial pass after the narrow phase reads
     /// these instead of the contact records).
@@ -262,6 +264,7 @@ impl World {
             contact_solver: ContactSolver::default(),
             joint_solver: Default::default(),
             candidates: Vec::new(),
+            colour_keys: Vec::new(),
             outcomes: Vec::new(),
             solver_contacts: Vec::new(),
             active_contacts: Vec::new(),

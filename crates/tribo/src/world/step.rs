@@ -15,10 +15,10 @@ use crate::dynamics::{mix, BodyType};
 use crate::error::{Error, Result};
 use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
-use crate::solver::contact_set::{Candidate, Candidates};
+use crate::solver::contact_set::{Candidate, Candidates, ColourKey};
 use crate::solver::contact_solver::ConstraintBodies;
 use crate::solver::{
-    for_each_mut, for_each_mut3, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints, StepContext,
+    for_each_mut, for_each_mut4, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints, StepContext,
 };
 use crate::world::Arena;
 use crate::world::{box_velocity, copy_boxes, next_box};
@@ -271,19 +271,22 @@ impl World {
         let mut flags = core::mem::take(&mut self.scratch_flags);
         let mut outcomes = core::mem::take(&mut self.outcomes);
         let mut candidates = core::mem::take(&mut self.candidates);
+        let mut keys = core::mem::take(&mut self.colour_keys);
         // Slots are written before they are read (every listed contact gets an outcome, a
-        // solvable one its candidate): no clearing.
+        // solvable one its candidate and colouring key): no clearing.
         outcomes.resize(self.contacts.len(), (NarrowOutcome::Skipped, false));
         candidates.resize(self.contacts.len(), Candidate::SKIP);
+        keys.resize(self.contacts.len(), ColourKey::default());
         let (shapes, solver_bodies, bounds) = (&self.shapes, &self.solver_bodies, &self.shape_bounds);
         // Updates one contact, writes its outcome and, if it is touching with an awake
         // dynamic side, its candidate.
-        let update = |ci: usize, c: &mut Contact, cand: &mut Candidate, out: &mut (NarrowOutcome, bool)| {
-            let outcome = narrow_phase(c, solver_bodies, bounds, shapes, dt);
-            let solvable = matches!(outcome, NarrowOutcome::Updated { touching: true, .. })
-                && candidate(ci as u32, c, solver_bodies, cand);
-            *out = (outcome, solvable);
-        };
+        let update =
+            |ci: usize, c: &mut Contact, cand: &mut Candidate, key: &mut ColourKey, out: &mut (NarrowOutcome, bool)| {
+                let outcome = narrow_phase(c, solver_bodies, bounds, shapes, dt);
+                let solvable = matches!(outcome, NarrowOutcome::Updated { touching: true, .. })
+                    && candidate(ci as u32, c, solver_bodies, cand, key);
+                *out = (outcome, solvable);
+            };
         let mostly_awake = self.active_body_flags(&mut flags);
         let mut mark = core::mem::take(&mut self.scratch_mark);
         mark.clear();
@@ -303,19 +306,17 @@ impl World {
         }
         let (flags_ref, mark_ref) = (&flags, &mark);
         let flag = |bi: u32| flags_ref.get(bi as usize).copied().unwrap_or(false);
-        for_each_mut3(
+        for_each_mut4(
             parallel,
-            &mut self.contacts,
-            &mut candidates,
-            &mut outcomes,
+            (&mut self.contacts, &mut candidates, &mut keys, &mut outcomes),
             CONTACT_CHUNK,
-            |ci, slot, cand, out| {
+            |ci, slot, cand, key, out| {
                 // The mark first: a sleeping contact's record is not even read.
                 if !mostly_awake && !mark_ref[ci] {
                     return;
                 }
                 match slot.as_mut() {
-                    Some(c) if !mostly_awake || flag(c.body_a) || flag(c.body_b) => update(ci, c, cand, out),
+                    Some(c) if !mostly_awake || flag(c.body_a) || flag(c.body_b) => update(ci, c, cand, key, out),
                     _ => *out = (NarrowOutcome::Skipped, false),
                 }
             },
@@ -390,8 +391,8 @@ impl World {
             solvable.clear();
             for &ci in &touching {
                 if let Some(Some(c)) = self.contacts.get(ci as usize) {
-                    if let Some(slot) = candidates.get_mut(ci as usize) {
-                        if candidate(ci, c, &self.solver_bodies, slot) {
+                    if let (Some(slot), Some(key)) = (candidates.get_mut(ci as usize), keys.get_mut(ci as usize)) {
+                        if candidate(ci, c, &self.solver_bodies, slot, key) {
                             solvable.push(ci);
                         }
                     }
@@ -401,6 +402,7 @@ impl World {
         self.touching_contacts = touching;
         self.solver_contacts = solvable;
         self.candidates = candidates;
+        self.colour_keys = keys;
     }
 
     /// One flag per body slot: awake and not static (read in body order, so the contacts
@@ -526,7 +528,7 @@ impl World {
         let g = self.def.gravity;
         let mut solver = core::mem::take(&mut self.contact_solver);
         solver.up = (-g).normalize_or_zero();
-        let candidates = Candidates::new(&self.candidates, &self.solver_contacts);
+        let candidates = Candidates::new(&self.candidates, &self.colour_keys, &self.solver_contacts);
         solver.build(ctx, &self.states, &self.sims, candidates);
         self.build_joints(ctx);
         self.profile.solver_setup = bodies_ms + lap.lap();
@@ -787,7 +789,7 @@ const SHORT_CONTACT_LIST: usize = 16;
 const PAIR_PREFETCH: usize = 8;
 
 /// The solver's input of a touching contact with an awake dynamic side (`None` otherwise).
-fn candidate(ci: u32, c: &Contact, solver_bodies: &[SolverBody], out: &mut Candidate) -> bool {
+fn candidate(ci: u32, c: &Contact, solver_bodies: &[SolverBody], out: &mut Candidate, key: &mut ColourKey) -> bool {
     if !c.touching {
         return false;
     }
@@ -814,6 +816,7 @@ fn candidate(ci: u32, c: &Contact, solver_bodies: &[SolverBody], out: &mut Candi
             center_b: bb.center,
         },
         c,
+        key,
     );
     true
 }
