@@ -36,7 +36,7 @@ use super::contact_solver::{
 use super::contact_wide::{self, StoredContact, WideCold, WideContact, WideHead, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
 use super::{
-    any_load, for_each_mut3, integrate_position_one, integrate_velocity_one, BodySim, ConstraintSet, SharedState,
+    any_load, for_each_chunk_mut3, integrate_position_one, integrate_velocity_one, BodySim, ConstraintSet, SharedState,
     SpinBarrier, StateCell, StateRead, StepContext,
 };
 use crate::collision::contact::{Contact, NO_COLOUR};
@@ -439,26 +439,42 @@ impl ContactSolver {
         // 4. Build and pack the coloured constraints, four lanes per task.
         let up = self.up;
         let lane_candidates = &self.lane_candidates;
-        for_each_mut3(
+        for_each_chunk_mut3(
             ctx.parallel,
             &mut self.head,
             &mut self.wide,
             &mut self.cold,
             GROUP_CHUNK,
-            |g, h, w, cold| {
-                if let Some(ahead) = lane_candidates.get(g + PREFETCH_GROUPS) {
-                    for &i in ahead {
-                        if let Some(cand) = candidates.get(i as usize) {
-                            super::prefetch(cand);
+            |first, heads, wides, colds| {
+                for k in 0..heads.len() {
+                    let g = first + k;
+                    if let Some(ahead) = lane_candidates.get(g + PREFETCH_GROUPS) {
+                        for &i in ahead {
+                            if let Some(cand) = candidates.get(i as usize) {
+                                super::prefetch(cand);
+                            }
                         }
                     }
+                    // The group's output lines too: read for ownership now, they are written
+                    // without waiting (a line only this core holds is then written in place).
+                    if let (Some(h), Some(w), Some(c)) = (
+                        heads.get(k + PREFETCH_GROUPS),
+                        wides.get(k + PREFETCH_GROUPS),
+                        colds.get(k + PREFETCH_GROUPS),
+                    ) {
+                        super::prefetch(h);
+                        super::prefetch(w);
+                        super::prefetch(c);
+                    }
+                    let lanes = lane_candidates[g].map(|i| {
+                        candidates
+                            .get(i as usize)
+                            .map(|cand| (cand.contact, &cand.input, &cand.bodies))
+                    });
+                    if let (Some(h), Some(w), Some(cold)) = (heads.get_mut(k), wides.get_mut(k), colds.get_mut(k)) {
+                        contact_wide::build_group(h, w, cold, lanes, up, ctx, states);
+                    }
                 }
-                let lanes = lane_candidates[g].map(|i| {
-                    candidates
-                        .get(i as usize)
-                        .map(|cand| (cand.contact, &cand.input, &cand.bodies))
-                });
-                contact_wide::build_group(h, w, cold, lanes, up, ctx, states);
             },
         );
         self.loaded = any_load(sims);

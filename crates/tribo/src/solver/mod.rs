@@ -521,7 +521,8 @@ pub(crate) fn for_each_mut<T: Send>(parallel: bool, items: &mut [T], min_len: us
     }
 }
 
-/// [`for_each_mut3`] over four slices.
+/// Calls `f(i, &mut a[i], &mut b[i], &mut c[i], &mut d[i])` for every index, split between
+/// the pool's threads when `parallel` (see [`for_each_mut`]).
 pub(crate) fn for_each_mut4<A: Send, B: Send, C: Send, D: Send>(
     parallel: bool,
     slices: (&mut [A], &mut [B], &mut [C], &mut [D]),
@@ -551,28 +552,27 @@ pub(crate) fn for_each_mut4<A: Send, B: Send, C: Send, D: Send>(
     }
 }
 
-/// Calls `f(i, &mut a[i], &mut b[i], &mut c[i])` for every index, split between the pool's
-/// threads when `parallel` (see [`for_each_mut`]).
-pub(crate) fn for_each_mut3<A: Send, B: Send, C: Send>(
+/// [`for_each_mut`] over three slices by chunks of `min_len`: `f(first, a, b, c)` gets a chunk of each slice
+/// (its first element at index `first`), so it can look ahead inside the chunk. One chunk
+/// on one thread.
+pub(crate) fn for_each_chunk_mut3<A: Send, B: Send, C: Send>(
     parallel: bool,
     a: &mut [A],
     b: &mut [B],
     c: &mut [C],
     min_len: usize,
-    f: impl Fn(usize, &mut A, &mut B, &mut C) + Sync,
+    f: impl Fn(usize, &mut [A], &mut [B], &mut [C]) + Sync,
 ) {
     if parallel {
         use rayon::prelude::*;
-        a.par_iter_mut()
-            .zip(b.par_iter_mut())
-            .zip(c.par_iter_mut())
+        let n = min_len.max(1);
+        a.par_chunks_mut(n)
+            .zip(b.par_chunks_mut(n))
+            .zip(c.par_chunks_mut(n))
             .enumerate()
-            .with_min_len(min_len)
-            .for_each(|(i, ((x, y), z))| f(i, x, y, z));
+            .for_each(|(k, ((x, y), z))| f(k * n, x, y, z));
     } else {
-        for (i, ((x, y), z)) in a.iter_mut().zip(b.iter_mut()).zip(c.iter_mut()).enumerate() {
-            f(i, x, y, z);
-        }
+        f(0, a, b, c);
     }
 }
 
