@@ -2,11 +2,12 @@
 //! wide packing, overflow, mass-ratio groups, and the [`ConstraintSet`] stages over them.
 //!
 //! Build (once per step, from the touching contacts in contact order):
-//! 1. colour every constraint: the colour it had last step while that is still free (so a
-//!    pile keeps its layout from step to step, as Box2D v3's persistent graph colours do),
-//!    else greedy first fit on per-body colour masks: moving pairs take the lowest free
-//!    colour, pairs with a static or kinematic side the highest, so each pass solves them
-//!    last, as Box2D v3's `constraint_graph.c` does; no free colour → overflow;
+//! 1. colour every constraint (from its [`ColourKey`]): the colour it had last step while
+//!    that is still free (so a pile keeps its layout from step to step, as Box2D v3's
+//!    persistent graph colours do), else greedy first fit on per-body colour masks:
+//!    moving pairs take the lowest free colour, pairs with a static or kinematic side the
+//!    highest, so each pass solves them last, as Box2D v3's `constraint_graph.c` does; no
+//!    free colour → overflow;
 //! 2. lay the colours out as runs of groups of four lanes ([`WideHead`] + [`WideContact`]
 //!    + [`WideCold`]); inside a colour, face contacts whose two points both carried load
 //!    go first (they will most likely take the 2×2 block's fast path together);
@@ -14,8 +15,8 @@
 //!    constraint whole in the overflow list ([`build_constraint`]).
 //!
 //! Store (after the substeps): each group computes what its lanes write into their
-//! contacts ([`contact_wide::store_group`]), then the solved contacts copy it in contact
-//! order.
+//! contacts ([`contact_wide::store_group`]) and writes it (with threads: each thread
+//! the contacts of its own range, see [`ContactSolver::store`]).
 //!
 //! The physics of a lane and of a scalar constraint are the same ([`contact_wide`] docs);
 //! the scalar code still runs wherever it is simpler: overflow, the warm-start estimate of
