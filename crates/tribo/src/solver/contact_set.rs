@@ -76,14 +76,13 @@ impl Candidate {
         self.input.fill(c);
         let input = &self.input;
         let b = &self.bodies;
-        let fresh = input.points[..input.count.min(2)].iter().any(|p| p.fresh);
         let flag = |on: bool, bit: u8| if on { bit } else { 0 };
         *key = ColourKey {
             index_a: b.index_a,
             index_b: b.index_b,
             colour,
             flags: flag(fast_first(input), FAST)
-                | flag(fresh, FRESH)
+                | flag(input.has_fresh_point(), FRESH)
                 | flag(b.index_a != 0 && dynamic_side(b.inv_mass_a, b.inv_i_a), KEY_DYNAMIC_A)
                 | flag(b.index_b != 0 && dynamic_side(b.inv_mass_b, b.inv_i_b), KEY_DYNAMIC_B)
                 | flag(mass_ratio(b).is_some(), KEY_RATIO),
@@ -328,8 +327,11 @@ impl ContactSolver {
             // the extra sweeps pile up impulses without bound until the states overflowed).
             // The candidate (masses, normal) is read only for such a pair.
             if key.flags & KEY_RATIO != 0 {
-                if let Some((ratio, body, heavy, a_is_light)) = candidates.get(i).and_then(|c| mass_ratio(&c.bodies)) {
-                    let n = candidates.get(i).map_or(Vec2::ZERO, |c| c.input.normal);
+                let cand = candidates.get(i);
+                if let Some(((ratio, body, heavy, a_is_light), cand)) =
+                    cand.and_then(|c| Some((mass_ratio(&c.bodies)?, c)))
+                {
+                    let n = cand.input.normal;
                     let to_heavy = if a_is_light { n } else { -n };
                     let carries = self.up == Vec2::ZERO || to_heavy.dot(self.up) > MIN_CARRY_COSINE;
                     let free = sims.get(heavy as usize).is_some_and(|s| !s.jointed);
@@ -409,8 +411,7 @@ impl ContactSolver {
                 let Some(cand) = candidates.get(i) else { continue };
                 let b = &cand.bodies;
                 let cc = build_constraint(cand.contact, &cand.input, b, self.up, &soft, ctx, states);
-                let input = &cand.input;
-                if input.points[..input.count.min(2)].iter().any(|p| p.fresh) {
+                if cand.input.has_fresh_point() {
                     self.fresh.push(Slot::Overflow(self.overflow.len() as u32));
                 }
                 self.overflow.push(cc);

@@ -201,6 +201,11 @@ impl ContactInput {
         rolling_impulse: 0.0,
     };
 
+    /// Whether a point is new this step (the warm-start estimate looks at the constraint).
+    pub fn has_fresh_point(&self) -> bool {
+        self.points[..self.count.min(2)].iter().any(|p| p.fresh)
+    }
+
     /// Writes what building a constraint reads of contact `c` in place (no copy).
     pub fn fill(&mut self, c: &Contact) {
         self.normal = c.manifold.normal;

@@ -552,9 +552,9 @@ pub(crate) fn for_each_mut4<A: Send, B: Send, C: Send, D: Send>(
     }
 }
 
-/// [`for_each_mut`] over three slices by chunks of `min_len`: `f(first, a, b, c)` gets a chunk of each slice
-/// (its first element at index `first`), so it can look ahead inside the chunk. One chunk
-/// on one thread.
+/// [`for_each_mut`] over three slices by chunks of `min_len`: `f(first, a, b, c)` gets a
+/// chunk of each slice (its first element at index `first`), so it can look ahead inside
+/// the chunk. One chunk on one thread.
 pub(crate) fn for_each_chunk_mut3<A: Send, B: Send, C: Send>(
     parallel: bool,
     a: &mut [A],

@@ -788,7 +788,8 @@ const SHORT_CONTACT_LIST: usize = 16;
 /// How many moved shapes ahead [`World::update_pairs`] asks for their records.
 const PAIR_PREFETCH: usize = 8;
 
-/// The solver's input of a touching contact with an awake dynamic side (`None` otherwise).
+/// Writes the solver's input and colouring key of a touching contact with an awake dynamic
+/// side into `out` and `key`; false (nothing written) otherwise.
 fn candidate(ci: u32, c: &Contact, solver_bodies: &[SolverBody], out: &mut Candidate, key: &mut ColourKey) -> bool {
     if !c.touching {
         return false;
