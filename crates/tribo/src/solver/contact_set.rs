@@ -231,7 +231,9 @@ const TEAM_BLOCK: usize = 16;
 
 /// A block of one colour's groups for the substep team: claimed by one thread per pass
 /// (`claimed` holds the number of the last pass that took it); the mutex only hands the
-/// claiming thread its `&mut` (never contended).
+/// claiming thread its `&mut` (never contended). One per cache line: a claim writes no
+/// line another thread's blocks share.
+#[repr(align(64))]
 struct TeamBlock<'a> {
     claimed: core::sync::atomic::AtomicU32,
     part: std::sync::Mutex<(&'a mut [WideHead], &'a mut [WideContact])>,
@@ -906,20 +908,30 @@ impl ContactSolver {
             for colour in &colours {
                 *pass += 1;
                 let stamp = *pass;
+                // Whether this thread claimed the block (and solved it).
                 let run = |block: &TeamBlock<'_>| {
-                    if block.claimed.swap(stamp, core::sync::atomic::Ordering::AcqRel) != stamp {
+                    let mine = block.claimed.swap(stamp, core::sync::atomic::Ordering::AcqRel) != stamp;
+                    if mine {
                         let mut guard = block.part.lock().unwrap_or_else(|e| e.into_inner());
                         let (heads, wides) = &mut *guard;
                         for (h, w) in heads.iter_mut().zip(wides.iter_mut()) {
                             f(h, w);
                         }
                     }
+                    mine
                 };
                 let share = colour.len().div_ceil(threads);
                 let (start, end) = ((k * share).min(colour.len()), ((k + 1) * share).min(colour.len()));
-                colour[start..end].iter().for_each(run);
-                colour[end..].iter().rev().for_each(run);
-                colour[..start].iter().rev().for_each(run);
+                // Its own share whole (every block is then solved by someone); the others'
+                // only up to the first block already taken, as Box2D v3's stages steal: the
+                // owner works towards it, so the blocks beyond are taken too, or soon will be.
+                // Trying every block costs a cache-line transfer per block (the owner's claim
+                // stamp), twice per pass.
+                colour[start..end].iter().for_each(|b| {
+                    run(b);
+                });
+                let _ = colour[end..].iter().rev().all(run);
+                let _ = colour[..start].iter().rev().all(run);
                 barrier.wait();
             }
         };
