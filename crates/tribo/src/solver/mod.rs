@@ -521,6 +521,29 @@ pub(crate) fn for_each_mut<T: Send>(parallel: bool, items: &mut [T], min_len: us
     }
 }
 
+/// Calls `f(i, &mut a[i], &mut b[i])` for every index of both, split between the pool's
+/// threads when `parallel` (see [`for_each_mut`]).
+pub(crate) fn for_each_mut2<A: Send, B: Send>(
+    parallel: bool,
+    a: &mut [A],
+    b: &mut [B],
+    min_len: usize,
+    f: impl Fn(usize, &mut A, &mut B) + Sync,
+) {
+    if parallel {
+        use rayon::prelude::*;
+        a.par_iter_mut()
+            .zip(b.par_iter_mut())
+            .enumerate()
+            .with_min_len(min_len)
+            .for_each(|(i, (x, y))| f(i, x, y));
+    } else {
+        for (i, (x, y)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
+            f(i, x, y);
+        }
+    }
+}
+
 /// Calls `f(i, &mut a[i], &mut b[i], &mut c[i], &mut d[i])` for every index, split between
 /// the pool's threads when `parallel` (see [`for_each_mut`]).
 pub(crate) fn for_each_mut4<A: Send, B: Send, C: Send, D: Send>(

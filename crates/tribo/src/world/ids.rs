@@ -139,6 +139,24 @@ impl<T> Arena<T> {
         });
     }
 
+    /// [`Arena::for_each_live_mut`] with each live value's entry of `other` (indexed by
+    /// slot; slots past its end are not visited).
+    pub fn for_each_live_mut_with<U: Send>(
+        &mut self,
+        parallel: bool,
+        min_len: usize,
+        other: &mut [U],
+        f: impl Fn(u32, &mut T, &mut U) + Sync,
+    ) where
+        T: Send,
+    {
+        crate::solver::for_each_mut2(parallel, &mut self.slots, other, min_len, |i, slot, u| {
+            if let Some(v) = slot.value.as_mut() {
+                f(i as u32, v, u);
+            }
+        });
+    }
+
     /// The generation currently stored at a slot.
     #[inline]
     pub fn generation(&self, index: u32) -> u32 {

@@ -212,9 +212,9 @@ pub struct World {
     pub(crate) scratch_mark: Vec<bool>,
     /// Scratch: one flag per body slot (active bodies, see `collect_active_contacts`).
     pub(crate) scratch_flags: Vec<bool>,
-    /// Scratch of a parallel finalize: per awake body, its one shape's next box when it
-    /// stays inside the fat box (see `World::finalize`).
-    pub(crate) scratch_boxes: Vec<Option<Aabb>>,
+    /// Scratch of a parallel finalize: per solver slot, whether its body's one shape got
+    /// its next box (inside the fat box) in the parallel pass (see `World::finalize`).
+    pub(crate) scratch_fitted: Vec<core::sync::atomic::AtomicBool>,
     /// Per solver slot: touched something this step (`finalize`'s sweep rule).
     pub(crate) scratch_touched: Vec<bool>,
     /// Static shapes found by the continuous check (`stop_at_static_shapes`).
@@ -273,7 +273,7 @@ impl World {
             scratch_f32: Vec::new(),
             scratch_mark: Vec::new(),
             scratch_flags: Vec::new(),
-            scratch_boxes: Vec::new(),
+            scratch_fitted: Vec::new(),
             scratch_touched: Vec::new(),
             scratch_found: Vec::new(),
             shared_states: Vec::new(),

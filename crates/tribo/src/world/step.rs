@@ -18,10 +18,10 @@ use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::{Candidate, Candidates, ColourKey};
 use crate::solver::contact_solver::ConstraintBodies;
 use crate::solver::{
-    for_each_mut, for_each_mut4, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints, StepContext,
+    for_each_mut4, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints, StepContext,
 };
 use crate::world::Arena;
-use crate::world::{box_velocity, copy_boxes, next_box};
+use crate::world::{box_velocity, next_box};
 use crate::world::{BodyId, ShapeId};
 
 impl World {
@@ -631,34 +631,47 @@ impl World {
                 }
             }
         }
-        // With threads, the boxes of one-shape bodies are computed in parallel first; a box
-        // that stays inside its fat box is then only stored by the serial pass below.
-        let mut boxes = core::mem::take(&mut self.scratch_boxes);
-        boxes.clear();
-        if parallel && dt > 0.0 {
-            boxes.resize(self.states.len(), None);
-            let (bodies, shapes, sims, limit) = (&self.bodies, &self.shapes, &self.sims, self.def.max_linear_speed);
-            let touched = &touched;
-            for_each_mut(parallel, &mut boxes, BODY_CHUNK, |k, out| {
-                let Some(b) = sims.get(k).filter(|_| k > 0).and_then(|sim| bodies.at(sim.body)) else {
-                    return;
-                };
-                let [sid] = b.shapes[..] else { return };
-                if b.non_finite {
-                    return;
-                }
-                let Some(s) = shapes.get(sid.index, sid.generation) else {
-                    return;
-                };
-                let check = b.body_type == BodyType::Dynamic;
-                let sweep = b.bullet || !touched[k];
-                let moved = (b.center - b.center0).length();
-                *out = next_box(s, b.xf, box_velocity(b, limit), dt, check, sweep, moved)
-                    .filter(|aabb| s.fat_aabb.contains(*aabb));
-            });
+        // The boxes of one-shape bodies are computed shape by shape (in parallel with
+        // threads); a box that stays inside its fat box is stored there (a shape writes only
+        // itself and its bounds) and its body flagged. Only the other bodies go through the
+        // serial pass below, which moves tree proxies (with threads it used to store every
+        // box: many_pyramids' finalize took as long on two threads as on one).
+        let mut fitted = core::mem::take(&mut self.scratch_fitted);
+        fitted.clear();
+        if dt > 0.0 {
+            use core::sync::atomic::{AtomicBool, Ordering::Relaxed};
+            fitted.resize_with(self.states.len(), || AtomicBool::new(false));
+            let (bodies, solver_bodies, limit) = (&self.bodies, &self.solver_bodies, self.def.max_linear_speed);
+            let (touched, flags) = (&touched, &fitted);
+            self.shapes
+                .for_each_live_mut_with(parallel, BODY_CHUNK, &mut self.shape_bounds, |_, s, bounds| {
+                    let bi = s.body.index;
+                    let k = solver_bodies.get(bi as usize).map_or(0, |sb| sb.index as usize);
+                    let Some(b) = bodies.at(bi).filter(|_| k != 0) else {
+                        return;
+                    };
+                    // One shape (this one), a finite state.
+                    if b.shapes.len() != 1 || b.non_finite {
+                        return;
+                    }
+                    let check = b.body_type == BodyType::Dynamic;
+                    let sweep = b.bullet || !touched[k];
+                    let moved = (b.center - b.center0).length();
+                    let next = next_box(s, b.xf, box_velocity(b, limit), dt, check, sweep, moved);
+                    if let Some(aabb) = next.filter(|aabb| s.fat_aabb.contains(*aabb)) {
+                        s.aabb = aabb;
+                        (bounds.aabb, bounds.fat_aabb) = (aabb, s.fat_aabb);
+                        if let Some(f) = flags.get(k) {
+                            f.store(true, Relaxed);
+                        }
+                    }
+                });
         }
-        // Fat boxes and the trees, in solver order (the trees are shared).
+        // The other bodies' fat boxes and the trees, in solver order (the trees are shared).
         for k in 1..self.states.len() {
+            if fitted.get_mut(k).is_some_and(|f| *f.get_mut()) {
+                continue; // fitted above
+            }
             let bi = self.sims[k].body;
             let Some(b) = self.bodies.at_mut(bi) else { continue };
             if b.non_finite {
@@ -670,21 +683,10 @@ impl World {
                 self.non_finite.push(id);
                 continue;
             }
-            let fitted = boxes.get(k).copied().flatten();
-            match (fitted, b.shapes.first().copied()) {
-                (Some(aabb), Some(sid)) => {
-                    if let Some(s) = self.shapes.get_mut(sid.index, sid.generation) {
-                        s.aabb = aabb;
-                        copy_boxes(&mut self.shape_bounds, sid.index, s);
-                    }
-                }
-                _ => {
-                    let sweep = b.bullet || !touched[k];
-                    self.refresh_body_proxies(bi, dt, sweep)
-                }
-            }
+            let sweep = b.bullet || !touched[k];
+            self.refresh_body_proxies(bi, dt, sweep);
         }
-        self.scratch_boxes = boxes;
+        self.scratch_fitted = fitted;
         self.scratch_touched = touched;
     }
 
