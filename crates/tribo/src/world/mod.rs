@@ -187,8 +187,6 @@ pub struct World {
     // Scratch buffers reused every step (no per-step allocation once warm).
     pub(crate) states: Vec<BodyState>,
     pub(crate) sims: Vec<BodySim>,
-    /// The states as the worker threads share them during the substeps (reused).
-    pub(crate) shared_states: Vec<crate::solver::SharedState>,
     pub(crate) contact_solver: ContactSolver,
     pub(crate) joint_solver: crate::solver::joint_solver::JointSolver,
     /// The solver's input of each contact slot, written by the narrow phase for the
@@ -276,7 +274,6 @@ impl World {
             scratch_fitted: Vec::new(),
             scratch_touched: Vec::new(),
             scratch_found: Vec::new(),
-            shared_states: Vec::new(),
             solver_bodies: Vec::new(),
             step_count: 0,
             reordered_at: None,

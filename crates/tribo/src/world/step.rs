@@ -538,16 +538,9 @@ impl World {
             contacts: &mut solver,
         };
         if ctx.parallel {
-            // Threads share the states (`SharedState`, 32 bytes each) for the substeps,
-            // then copy them back; the shared array is kept from step to step.
-            let mut shared = core::mem::take(&mut self.shared_states);
-            shared.clear();
-            shared.extend(self.states.iter().map(|&s| SharedState::new(s)));
-            solve_step(ctx, &self.sims, &shared, &mut set, &mut self.profile);
-            for (s, x) in self.states.iter_mut().zip(&shared) {
-                *s = x.load();
-            }
-            self.shared_states = shared;
+            // Threads share the states in place (`SharedState`, 32 bytes each).
+            let shared = SharedState::from_mut_slice(&mut self.states);
+            solve_step(ctx, &self.sims, shared, &mut set, &mut self.profile);
         } else {
             let cells = core::cell::Cell::from_mut(&mut self.states[..]).as_slice_of_cells();
             solve_step(ctx, &self.sims, cells, &mut set, &mut self.profile);
