@@ -559,37 +559,6 @@ pub(crate) fn for_each_mut2<A: Send, B: Send>(
     }
 }
 
-/// Calls `f(i, &mut a[i], &mut b[i], &mut c[i], &mut d[i])` for every index, split between
-/// the pool's threads when `parallel` (see [`for_each_mut`]).
-pub(crate) fn for_each_mut4<A: Send, B: Send, C: Send, D: Send>(
-    parallel: bool,
-    slices: (&mut [A], &mut [B], &mut [C], &mut [D]),
-    min_len: usize,
-    f: impl Fn(usize, &mut A, &mut B, &mut C, &mut D) + Sync,
-) {
-    let (a, b, c, d) = slices;
-    if parallel {
-        use rayon::prelude::*;
-        a.par_iter_mut()
-            .zip(b.par_iter_mut())
-            .zip(c.par_iter_mut())
-            .zip(d.par_iter_mut())
-            .enumerate()
-            .with_min_len(min_len)
-            .for_each(|(i, (((w, x), y), z))| f(i, w, x, y, z));
-    } else {
-        for (i, (((w, x), y), z)) in a
-            .iter_mut()
-            .zip(b.iter_mut())
-            .zip(c.iter_mut())
-            .zip(d.iter_mut())
-            .enumerate()
-        {
-            f(i, w, x, y, z);
-        }
-    }
-}
-
 /// [`for_each_mut`] over three slices by chunks of `min_len`: `f(first, a, b, c)` gets a
 /// chunk of each slice (its first element at index `first`), so it can look ahead inside
 /// the chunk. One chunk on one thread.
@@ -611,6 +580,28 @@ pub(crate) fn for_each_chunk_mut3<A: Send, B: Send, C: Send>(
             .for_each(|(k, ((x, y), z))| f(k * n, x, y, z));
     } else {
         f(0, a, b, c);
+    }
+}
+
+/// [`for_each_chunk_mut3`] over four slices.
+pub(crate) fn for_each_chunk_mut4<A: Send, B: Send, C: Send, D: Send>(
+    parallel: bool,
+    slices: (&mut [A], &mut [B], &mut [C], &mut [D]),
+    min_len: usize,
+    f: impl Fn(usize, &mut [A], &mut [B], &mut [C], &mut [D]) + Sync,
+) {
+    let (a, b, c, d) = slices;
+    if parallel {
+        use rayon::prelude::*;
+        let n = min_len.max(1);
+        a.par_chunks_mut(n)
+            .zip(b.par_chunks_mut(n))
+            .zip(c.par_chunks_mut(n))
+            .zip(d.par_chunks_mut(n))
+            .enumerate()
+            .for_each(|(k, (((w, x), y), z))| f(k * n, w, x, y, z));
+    } else {
+        f(0, a, b, c, d);
     }
 }
 

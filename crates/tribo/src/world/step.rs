@@ -18,7 +18,7 @@ use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::{Candidate, Candidates, ColourKey};
 use crate::solver::contact_solver::ConstraintBodies;
 use crate::solver::{
-    for_each_mut4, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints, StepContext,
+    for_each_chunk_mut4, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints, StepContext,
 };
 use crate::world::Arena;
 use crate::world::{box_velocity, next_box};
@@ -306,18 +306,41 @@ impl World {
         }
         let (flags_ref, mark_ref) = (&flags, &mark);
         let flag = |bi: u32| flags_ref.get(bi as usize).copied().unwrap_or(false);
-        for_each_mut4(
+        for_each_chunk_mut4(
             parallel,
             (&mut self.contacts, &mut candidates, &mut keys, &mut outcomes),
             CONTACT_CHUNK,
-            |ci, slot, cand, key, out| {
-                // The mark first: a sleeping contact's record is not even read.
-                if !mostly_awake && !mark_ref[ci] {
-                    return;
-                }
-                match slot.as_mut() {
-                    Some(c) if !mostly_awake || flag(c.body_a) || flag(c.body_b) => update(ci, c, cand, key, out),
-                    _ => *out = (NarrowOutcome::Skipped, false),
+            |first, slots, cands, keys, outs| {
+                for k in 0..slots.len() {
+                    let ci = first + k;
+                    // The mark first: a sleeping contact's record is not even read.
+                    if !mostly_awake && !mark_ref.get(ci).copied().unwrap_or(false) {
+                        continue;
+                    }
+                    // The bodies and shape bounds of a contact a few ahead: loads that
+                    // miss (contacts come in solver order, not body order) and that the
+                    // narrow phase needs before anything else.
+                    if let Some(Some(ahead)) = slots.get(k + NARROW_PREFETCH) {
+                        for bi in [ahead.body_a, ahead.body_b] {
+                            if let Some(sb) = solver_bodies.get(bi as usize) {
+                                crate::solver::prefetch(sb);
+                            }
+                        }
+                        for id in [ahead.shape_a, ahead.shape_b] {
+                            if let Some(sb) = bounds.get(id.index as usize) {
+                                crate::solver::prefetch(sb);
+                            }
+                        }
+                    }
+                    let (Some(slot), Some(cand), Some(key), Some(out)) =
+                        (slots.get_mut(k), cands.get_mut(k), keys.get_mut(k), outs.get_mut(k))
+                    else {
+                        continue;
+                    };
+                    match slot.as_mut() {
+                        Some(c) if !mostly_awake || flag(c.body_a) || flag(c.body_b) => update(ci, c, cand, key, out),
+                        _ => *out = (NarrowOutcome::Skipped, false),
+                    }
                 }
             },
         );
@@ -777,6 +800,9 @@ const BODY_CHUNK: usize = 256;
 
 /// Contacts per parallel chunk of the narrow phase and the impulse store.
 const CONTACT_CHUNK: usize = 256;
+
+/// How many contacts ahead the narrow phase asks for their bodies and shape bounds.
+const NARROW_PREFETCH: usize = 4;
 
 /// Contact lists up to this long are searched for an existing pair instead of the pair
 /// table (a few keys in one cache line beat a hash probe into a large table).
