@@ -319,8 +319,10 @@ impl World {
                     }
                     // The bodies and shape bounds of a contact a few ahead: loads that
                     // miss (contacts come in solver order, not body order) and that the
-                    // narrow phase needs before anything else.
-                    if let Some(Some(ahead)) = slots.get(k + NARROW_PREFETCH) {
+                    // narrow phase needs before anything else. Not for a sleeping one,
+                    // whose record the mark keeps unread.
+                    let ahead_active = mostly_awake || mark_ref.get(ci + NARROW_PREFETCH).copied().unwrap_or(false);
+                    if let Some(Some(ahead)) = slots.get(k + NARROW_PREFETCH).filter(|_| ahead_active) {
                         for bi in [ahead.body_a, ahead.body_b] {
                             if let Some(sb) = solver_bodies.get(bi as usize) {
                                 crate::solver::prefetch(sb);
