@@ -14,6 +14,9 @@
 //! 3. build the groups four lanes at a time ([`contact_wide::build_group`]), or keep a
 //!    constraint whole in the overflow list ([`build_constraint`]).
 //!
+//! Steps 1 and 2 are skipped when the candidates are last step's, unchanged
+//! ([`ContactSolver::same_layout`]): a resting pile keeps its colours and layout.
+//!
 //! Store (after the substeps): each group computes what its lanes write into their
 //! contacts ([`contact_wide::store_group`]) and writes it (with threads: each thread
 //! the contacts of its own range, see [`ContactSolver::store`]).
@@ -217,10 +220,17 @@ pub(crate) struct ContactSolver {
     /// The colour of each group (stored into its contacts, tried first next step).
     group_colour: Vec<u8>,
     /// Candidate index of each lane of each group (`u32::MAX`: empty lane).
-    lane_candidates: Vec<[u32; LANES]>,
+    pub(crate) lane_candidates: Vec<[u32; LANES]>,
     /// The contact of each candidate ([`ContactSolver::solved_order`] reads these 4 bytes,
     /// not the candidates' records).
     contact_of: Vec<u32>,
+    /// Last step's candidates as the colouring left them: contact, key with the colour it
+    /// was given and without [`FAST`] ([`ContactSolver::same_layout`]).
+    last_keys: Vec<(u32, ColourKey)>,
+    /// Last step's layout had no overflow (only then may the next step keep it).
+    pub(crate) layout_kept: bool,
+    /// Steps that kept the last step's layout (for tests and diagnostics).
+    pub(crate) kept_layouts: u64,
     // Scratch reused every step.
     /// Each candidate's colour (with the [`FAST`] and [`FRESH`] flags) or [`OVERFLOW`].
     colours: Vec<u8>,
@@ -334,143 +344,14 @@ impl ContactSolver {
         candidates: Candidates<'_>,
     ) {
         self.overflow.clear();
-        self.fresh.clear();
         self.groups.clear();
-        // 1. Colours.
-        self.used.clear();
-        self.used.resize(states.len(), 0);
-        self.colours.clear();
-        let mut counts = [0u32; COLORS];
-        // Constraints likely to take the solver's fast path, per colour (see `fast_first`).
-        let mut fast_counts = [0u32; COLORS];
-        let mut light: Vec<(u32, u32)> = Vec::new(); // (light body state, sweeps)
-        let mut any_restitution = false;
-        self.contact_of.clear();
-        for (i, (contact, key)) in candidates.keys().enumerate() {
-            self.contact_of.push(contact);
-            // Only where the heavy body rests on the light one: it lies above it against
-            // gravity (a heavy container holding light bodies, Box2D's tumbler drum at
-            // 64 000 times its boxes' mass, carries them; they do not carry it), and it has
-            // no joint (a motor may press it on the light body with any torque: Box2D's
-            // spinner rotor, squeezing bodies against the wall with unbounded torque, made
-            // the extra sweeps pile up impulses without bound until the states overflowed).
-            // The candidate (masses, normal) is read only for such a pair.
-            if key.flags & KEY_RATIO != 0 {
-                let cand = candidates.get(i);
-                if let Some(((ratio, body, heavy, a_is_light), cand)) =
-                    cand.and_then(|c| Some((mass_ratio(&c.bodies)?, c)))
-                {
-                    let n = cand.input.normal;
-                    let to_heavy = if a_is_light { n } else { -n };
-                    let carries = self.up == Vec2::ZERO || to_heavy.dot(self.up) > MIN_CARRY_COSINE;
-                    let free = sims.get(heavy as usize).is_some_and(|s| !s.jointed);
-                    if carries && free {
-                        light.push((body, (ratio.ceil() as u32).min(MAX_LOCAL_SWEEPS)));
-                    }
-                }
-            }
-            let (da, db) = (key.flags & KEY_DYNAMIC_A != 0, key.flags & KEY_DYNAMIC_B != 0);
-            let busy = (if da { self.used[key.index_a as usize] } else { 0 })
-                | (if db { self.used[key.index_b as usize] } else { 0 });
-            // The colour of the last step when it is still free (a pile keeps its layout:
-            // `World::reorder_contacts`), else the lowest free colour below DYNAMIC_COLORS, or the
-            // highest free one from 1 up (bit scans of the free colours).
-            let open = if da && db {
-                DYNAMIC_COLOR_BITS
-            } else {
-                STATIC_COLOR_BITS
-            };
-            let kept = 1u32.checked_shl(key.colour as u32).unwrap_or(0) & open & !busy;
-            let colour = if kept != 0 {
-                Some(key.colour as usize)
-            } else if da && db {
-                let free = !busy & DYNAMIC_COLOR_BITS;
-                (free != 0).then(|| free.trailing_zeros() as usize)
-            } else {
-                let free = !busy & STATIC_COLOR_BITS;
-                (free != 0).then(|| 31 - free.leading_zeros() as usize)
-            };
-            match colour {
-                Some(k) => {
-                    if da {
-                        self.used[key.index_a as usize] |= 1 << k;
-                    }
-                    if db {
-                        self.used[key.index_b as usize] |= 1 << k;
-                    }
-                    counts[k] += 1;
-                    fast_counts[k] += (key.flags & FAST != 0) as u32;
-                    any_restitution |= key.flags & KEY_RESTITUTION != 0;
-                    self.colours.push(k as u8 | (key.flags & (FAST | FRESH)));
-                }
-                None => self.colours.push(OVERFLOW),
-            }
-        }
-        self.any_restitution = any_restitution;
-        // 2. Layout: colour k fills lanes from `next[k]` on (in lanes, not groups).
-        let mut next = [0u32; COLORS];
-        let mut next_slow = [0u32; COLORS];
-        let mut groups = 0u32;
-        self.ranges.clear();
-        self.slow_start.clear();
-        self.group_colour.clear();
-        for k in 0..COLORS {
-            next[k] = groups * LANES as u32;
-            next_slow[k] = next[k] + fast_counts[k];
-            let start = groups;
-            groups += counts[k].div_ceil(LANES as u32);
-            if groups > start {
-                self.ranges.push((start, groups));
-                self.slow_start
-                    .push(next_slow[k].div_ceil(LANES as u32).clamp(start, groups));
-                self.group_colour.resize(groups as usize, k as u8);
-            }
-        }
-        // Every lane is written whole below (packed or cleared): no memset.
-        self.head.resize(groups as usize, WideHead::default());
-        self.head.truncate(groups as usize);
-        self.wide.resize(groups as usize, WideContact::default());
-        self.cold.resize(groups as usize, WideCold::default());
-        self.wide.truncate(groups as usize);
-        self.cold.truncate(groups as usize);
-        // 3. Slots: overflow constraints are built here, coloured ones below.
         let soft = StepSoftness::new(ctx);
         self.soft = soft;
-        self.slots.clear();
-        self.lane_candidates.clear();
-        self.lane_candidates.resize(groups as usize, [u32::MAX; LANES]);
-        // Reads only the colour bytes (and the rare overflow candidates), not the candidates.
-        for (i, &colour) in self.colours.iter().enumerate() {
-            let slot = if colour == OVERFLOW {
-                let Some(cand) = candidates.get(i) else { continue };
-                let b = &cand.bodies;
-                let cc = build_constraint(cand.contact, &cand.input, b, self.up, &soft, ctx, states);
-                if cand.input.has_fresh_point() {
-                    self.fresh.push(Slot::Overflow(self.overflow.len() as u32));
-                }
-                self.overflow.push(cc);
-                Slot::Overflow(self.overflow.len() as u32 - 1)
-            } else {
-                let k = (colour & !(FAST | FRESH)) as usize;
-                let next = if colour & FAST != 0 {
-                    &mut next[k]
-                } else {
-                    &mut next_slow[k]
-                };
-                let at = *next;
-                *next += 1;
-                let (group, lane) = (at / LANES as u32, at % LANES as u32);
-                self.lane_candidates[group as usize][lane as usize] = i as u32;
-                let slot = Slot::Wide {
-                    group,
-                    lane: lane as u8,
-                };
-                if colour & FRESH != 0 {
-                    self.fresh.push(slot);
-                }
-                slot
-            };
-            self.slots.push(slot);
+        let mut light: Vec<(u32, u32)> = Vec::new(); // (light body state, sweeps)
+        if self.same_layout(candidates, sims, &mut light) {
+            self.kept_layouts += 1;
+        } else {
+            self.colour_and_lay_out(ctx, states, sims, candidates, &mut light);
         }
         // 4. Build and pack the coloured constraints, four lanes per task.
         let up = self.up;
@@ -519,6 +400,200 @@ impl ContactSolver {
         }
         #[cfg(debug_assertions)]
         self.check_colours(states.len());
+    }
+
+    /// Steps 1–3 of the build: colours, layout, slots (and the overflow constraints, built
+    /// whole); `light` gets the light bodies under heavy ones.
+    fn colour_and_lay_out<S: StateRead + Sync>(
+        &mut self,
+        ctx: &StepContext,
+        states: &[S],
+        sims: &[BodySim],
+        candidates: Candidates<'_>,
+        light: &mut Vec<(u32, u32)>,
+    ) {
+        self.fresh.clear();
+        self.last_keys.clear();
+        self.layout_kept = true;
+        // 1. Colours.
+        self.used.clear();
+        self.used.resize(states.len(), 0);
+        self.colours.clear();
+        let mut counts = [0u32; COLORS];
+        // Constraints likely to take the solver's fast path, per colour (see `fast_first`).
+        let mut fast_counts = [0u32; COLORS];
+        let mut any_restitution = false;
+        self.contact_of.clear();
+        for (i, (contact, key)) in candidates.keys().enumerate() {
+            self.contact_of.push(contact);
+            if key.flags & KEY_RATIO != 0 {
+                light.extend(candidates.get(i).and_then(|cand| self.light_body(cand, sims)));
+            }
+            let (da, db) = (key.flags & KEY_DYNAMIC_A != 0, key.flags & KEY_DYNAMIC_B != 0);
+            let busy = (if da { self.used[key.index_a as usize] } else { 0 })
+                | (if db { self.used[key.index_b as usize] } else { 0 });
+            // The colour of the last step when it is still free (a pile keeps its layout:
+            // `World::reorder_contacts`), else the lowest free colour below DYNAMIC_COLORS, or the
+            // highest free one from 1 up (bit scans of the free colours).
+            let open = if da && db {
+                DYNAMIC_COLOR_BITS
+            } else {
+                STATIC_COLOR_BITS
+            };
+            let kept = 1u32.checked_shl(key.colour as u32).unwrap_or(0) & open & !busy;
+            let colour = if kept != 0 {
+                Some(key.colour as usize)
+            } else if da && db {
+                let free = !busy & DYNAMIC_COLOR_BITS;
+                (free != 0).then(|| free.trailing_zeros() as usize)
+            } else {
+                let free = !busy & STATIC_COLOR_BITS;
+                (free != 0).then(|| 31 - free.leading_zeros() as usize)
+            };
+            match colour {
+                Some(k) => {
+                    if da {
+                        self.used[key.index_a as usize] |= 1 << k;
+                    }
+                    if db {
+                        self.used[key.index_b as usize] |= 1 << k;
+                    }
+                    counts[k] += 1;
+                    fast_counts[k] += (key.flags & FAST != 0) as u32;
+                    any_restitution |= key.flags & KEY_RESTITUTION != 0;
+                    self.colours.push(k as u8 | (key.flags & (FAST | FRESH)));
+                    self.last_keys.push((
+                        contact,
+                        ColourKey {
+                            colour: k as u8,
+                            flags: key.flags & !FAST,
+                            ..*key
+                        },
+                    ));
+                }
+                None => {
+                    self.colours.push(OVERFLOW);
+                    self.layout_kept = false;
+                }
+            }
+        }
+        self.any_restitution = any_restitution;
+        // 2. Layout: colour k fills lanes from `next[k]` on (in lanes, not groups).
+        let mut next = [0u32; COLORS];
+        let mut next_slow = [0u32; COLORS];
+        let mut groups = 0u32;
+        self.ranges.clear();
+        self.slow_start.clear();
+        self.group_colour.clear();
+        for k in 0..COLORS {
+            next[k] = groups * LANES as u32;
+            next_slow[k] = next[k] + fast_counts[k];
+            let start = groups;
+            groups += counts[k].div_ceil(LANES as u32);
+            if groups > start {
+                self.ranges.push((start, groups));
+                self.slow_start
+                    .push(next_slow[k].div_ceil(LANES as u32).clamp(start, groups));
+                self.group_colour.resize(groups as usize, k as u8);
+            }
+        }
+        // Every lane is written whole below (packed or cleared): no memset.
+        self.head.resize(groups as usize, WideHead::default());
+        self.head.truncate(groups as usize);
+        self.wide.resize(groups as usize, WideContact::default());
+        self.cold.resize(groups as usize, WideCold::default());
+        self.wide.truncate(groups as usize);
+        self.cold.truncate(groups as usize);
+        // 3. Slots: overflow constraints are built here, coloured ones below.
+        let soft = self.soft;
+        self.slots.clear();
+        self.lane_candidates.clear();
+        self.lane_candidates.resize(groups as usize, [u32::MAX; LANES]);
+        // Reads only the colour bytes (and the rare overflow candidates), not the candidates.
+        for (i, &colour) in self.colours.iter().enumerate() {
+            let slot = if colour == OVERFLOW {
+                let Some(cand) = candidates.get(i) else { continue };
+                let b = &cand.bodies;
+                let cc = build_constraint(cand.contact, &cand.input, b, self.up, &soft, ctx, states);
+                if cand.input.has_fresh_point() {
+                    self.fresh.push(Slot::Overflow(self.overflow.len() as u32));
+                }
+                self.overflow.push(cc);
+                Slot::Overflow(self.overflow.len() as u32 - 1)
+            } else {
+                let k = (colour & !(FAST | FRESH)) as usize;
+                let next = if colour & FAST != 0 {
+                    &mut next[k]
+                } else {
+                    &mut next_slow[k]
+                };
+                let at = *next;
+                *next += 1;
+                let (group, lane) = (at / LANES as u32, at % LANES as u32);
+                self.lane_candidates[group as usize][lane as usize] = i as u32;
+                let slot = Slot::Wide {
+                    group,
+                    lane: lane as u8,
+                };
+                if colour & FRESH != 0 {
+                    self.fresh.push(slot);
+                }
+                slot
+            };
+            self.slots.push(slot);
+        }
+    }
+
+    /// Whether last step's colours and layout hold for `candidates` unchanged: the same
+    /// contacts in the same order, with the same bodies, last colours and flags, and no
+    /// overflow then. Each contact then keeps its colour (a valid colouring last step, of
+    /// the same pairs), so the full colouring would give the same colours and the same
+    /// layout, up to the order of [`FAST`] constraints inside a colour, which changes no
+    /// result (its flag is not compared: it follows each step's loads, and would otherwise
+    /// force a new layout in nearly every step of a resting pile). In large_pyramid and
+    /// many_pyramids all but the first steps keep their layout; a pile in motion (tumbler)
+    /// fails at once. `light` gets the light bodies under heavy ones, as the colouring
+    /// collects them.
+    fn same_layout(&self, candidates: Candidates<'_>, sims: &[BodySim], light: &mut Vec<(u32, u32)>) -> bool {
+        if !self.layout_kept || self.last_keys.len() != candidates.list.len() {
+            return false;
+        }
+        for (i, (&contact, &(last_contact, last))) in candidates.list.iter().zip(&self.last_keys).enumerate() {
+            let Some(key) = candidates.keys.get(contact as usize) else {
+                return false;
+            };
+            if contact != last_contact
+                || key.index_a != last.index_a
+                || key.index_b != last.index_b
+                || key.colour != last.colour
+                || key.flags & !FAST != last.flags
+            {
+                light.clear();
+                return false;
+            }
+            if key.flags & KEY_RATIO != 0 {
+                light.extend(candidates.get(i).and_then(|cand| self.light_body(cand, sims)));
+            }
+        }
+        true
+    }
+
+    /// A candidate between a light body and one more than [`MASS_RATIO_GROUP`] times
+    /// heavier that rests on it: (light body state, its sweeps).
+    fn light_body(&self, cand: &Candidate, sims: &[BodySim]) -> Option<(u32, u32)> {
+        // Only where the heavy body rests on the light one: it lies above it against
+        // gravity (a heavy container holding light bodies, Box2D's tumbler drum at 64 000
+        // times its boxes' mass, carries them; they do not carry it), and it has no joint (a
+        // motor may press it on the light body with any torque: Box2D's spinner rotor,
+        // squeezing bodies against the wall with unbounded torque, made the extra sweeps pile
+        // up impulses without bound until the states overflowed). The candidate (masses,
+        // normal) is read only for such a pair.
+        let (ratio, body, heavy, a_is_light) = mass_ratio(&cand.bodies)?;
+        let n = cand.input.normal;
+        let to_heavy = if a_is_light { n } else { -n };
+        let carries = self.up == Vec2::ZERO || to_heavy.dot(self.up) > MIN_CARRY_COSINE;
+        let free = sims.get(heavy as usize).is_some_and(|s| !s.jointed);
+        (carries && free).then(|| (body, (ratio.ceil() as u32).min(MAX_LOCAL_SWEEPS)))
     }
 
     /// The contacts solved in the last step in the order the solver laid them out (group
