@@ -70,6 +70,8 @@ pub(crate) struct BroadPhase {
     pub pairs: HashMap<u64, u32, BuildPairHasher>,
     /// Query copies of the trees ([`FlatTree`]), made when a step queries many proxies.
     pub flat: [FlatTree; 2],
+    /// Scratch of the pair update: per shape slot, whether its proxy moved.
+    pub moved_mark: Vec<bool>,
 }
 
 /// A pair update that queries at least 1/`FLAT_QUERY_SHARE` of a tree's proxy count

@@ -1231,6 +1231,70 @@ impl FlatTree {
     }
 }
 
+impl FlatTree {
+    /// Calls `callback(data_a, data_b)` once for every pair of leaves whose boxes overlap
+    /// (category bits are not tested: the caller filters the pairs), in an order fixed by
+    /// the tree.
+    ///
+    /// A walk of the tree against itself: the pairs inside a node's subtree are those
+    /// inside each child's subtree and those between its two children when their boxes
+    /// overlap; the pairs between two overlapping subtrees are found by descending the
+    /// larger (by perimeter) into its children that overlap the other. Each overlapping
+    /// pair of leaves is met once, where a query per leaf meets it from both sides, and
+    /// leaves close together share the walk down to them. Tumbler (2 025 moving boxes,
+    /// 8 500 overlapping pairs): 0.76 ms a step, against 1.9 ms for the queries of the
+    /// moved boxes and their pair tests.
+    pub fn self_pairs<F: FnMut(u64, u64)>(&self, mut callback: F) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        // Pending work: internal nodes whose subtree's own pairs remain, and pairs of child
+        // slots (`2 · node + child`) whose boxes overlap, between whose subtrees the pairs
+        // remain. Cross pairs first: they keep the stack short.
+        let mut inner: Vec<u32> = vec![0];
+        let mut cross: Vec<(u32, u32)> = Vec::new();
+        let overlap =
+            |a: Aabb, b: Aabb| !((a.min.x > b.max.x) | (a.min.y > b.max.y) | (b.min.x > a.max.x) | (b.min.y > a.max.y));
+        // A child slot's box, link and user data.
+        let slot = |x: u32| {
+            let (i, c) = ((x >> 1) as usize, (x & 1) as usize);
+            let n = self.nodes.get(i)?;
+            Some((n.boxes[c], n.links[c], self.data.get(i).map_or(0, |d| d[c])))
+        };
+        loop {
+            if let Some((x, y)) = cross.pop() {
+                let (Some((bx, lx, dx)), Some((by, ly, dy))) = (slot(x), slot(y)) else {
+                    continue;
+                };
+                let (leaf_x, leaf_y) = (lx & FLAT_LEAF != 0, ly & FLAT_LEAF != 0);
+                if leaf_x && leaf_y {
+                    callback(dx, dy);
+                    continue;
+                }
+                let descend_x = !leaf_x && (leaf_y || bx.perimeter() >= by.perimeter());
+                let (k, other, other_box) = if descend_x { (lx, y, by) } else { (ly, x, bx) };
+                let Some(n) = self.nodes.get(k as usize) else { continue };
+                for c in 0..2u32 {
+                    if overlap(n.boxes[c as usize], other_box) {
+                        cross.push((2 * k + c, other));
+                    }
+                }
+                continue;
+            }
+            let Some(i) = inner.pop() else { break };
+            let Some(n) = self.nodes.get(i as usize) else { continue };
+            for link in n.links {
+                if link & FLAT_LEAF == 0 {
+                    inner.push(link);
+                }
+            }
+            if overlap(n.boxes[0], n.boxes[1]) {
+                cross.push((2 * i, 2 * i + 1));
+            }
+        }
+    }
+}
+
 impl DynamicTree {
     /// Makes `out` a [`FlatTree`] copy of this tree (reusing its buffers).
     pub fn flatten_into(&self, out: &mut FlatTree) {
@@ -1408,6 +1472,25 @@ mod tests {
             assert!(!flat.is_copy_of(&t));
             t.flatten_into(&mut flat);
             assert!(flat.is_copy_of(&t));
+            // The walk of the copy against itself meets every overlapping pair of leaves
+            // exactly once (as a multiset of user-data pairs: brute force over all pairs).
+            if batch % 10 == 9 {
+                let key = |a: u64, b: u64| (a.min(b), a.max(b));
+                let mut expected = Vec::new();
+                for (i, &(p, bp, _)) in live.iter().enumerate() {
+                    for &(q, bq, _) in &live[i + 1..] {
+                        if bp.overlaps(bq) {
+                            expected.push(key(t.user_data(p).unwrap(), t.user_data(q).unwrap()));
+                        }
+                    }
+                }
+                let mut got = Vec::new();
+                flat.self_pairs(|a, b| got.push(key(a, b)));
+                expected.sort_unstable();
+                got.sort_unstable();
+                assert!(!expected.is_empty());
+                assert_eq!(got, expected, "batch {batch}");
+            }
             for _ in 0..20 {
                 let q = random_box(&mut r, 110.0, 30.0);
                 let mask = if r.below(2) == 0 {
@@ -1856,6 +1939,7 @@ mod tests {
             panic!("apart")
         });
         assert_eq!(got, vec![(id, 77)]);
+        flat.self_pairs(|_, _| panic!("one leaf makes no pair"));
     }
 
     #[test]

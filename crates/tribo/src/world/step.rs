@@ -104,7 +104,17 @@ impl World {
             }
         }
         let use_flat = self.broad_phase.prepare_queries(moved.len());
+        // When most of the moving tree moved (a pile in motion), its pairs come from one
+        // walk of the tree against itself instead of a query per moved shape: each
+        // overlapping pair is met once, not once from each side, and neighbours share the
+        // walk down to them (`FlatTree::self_pairs`). The moved shapes then query only the
+        // static tree.
+        let moving = MOVING_TREE as usize;
+        let join = use_flat[moving] && JOIN_SHARE * moved.len() >= self.broad_phase.trees[moving].proxy_count();
         let mut new_pairs: Vec<u64> = Vec::new();
+        if join {
+            self.join_moving_pairs(&moved, &mut new_pairs);
+        }
         let mut hits: Vec<u32> = Vec::new();
         for (j, &si) in moved.iter().enumerate() {
             // The moved shapes' records, their bodies and the bodies' key lists are asked
@@ -116,6 +126,8 @@ impl World {
             };
             let trees: &[u8] = if s.tree == STATIC_TREE {
                 &[MOVING_TREE]
+            } else if join {
+                &[STATIC_TREE]
             } else {
                 &[MOVING_TREE, STATIC_TREE]
             };
@@ -143,11 +155,7 @@ impl World {
                 }
                 let Some(o) = self.shapes.at(other) else { continue };
                 // When both moved, the lower index reports the pair.
-                if (o.moved && other < si) || o.body == s.body || !s.filter.should_collide(&o.filter) {
-                    continue;
-                }
-                let dynamic = body.is_dynamic() || self.bodies.at(o.body.index).is_some_and(|b| b.is_dynamic());
-                if dynamic && (body.joints.is_empty() || !self.joint_blocks_pair(s.body.index, o.body.index)) {
+                if !(o.moved && other < si) && self.may_pair(s, body, o) {
                     new_pairs.push(pair_key(si, other));
                 }
             }
@@ -164,6 +172,58 @@ impl World {
         for key in new_pairs {
             self.create_contact((key >> 32) as u32, key as u32);
         }
+    }
+
+    /// The new pairs of two shapes of the moving tree, one of which moved, into
+    /// `new_pairs`: one walk of the tree's [`FlatTree`] copy against itself (current: see
+    /// [`World::update_pairs`]); a pair with a contact is found in the pair table without
+    /// reading either shape's record.
+    fn join_moving_pairs(&mut self, moved: &[u32], new_pairs: &mut Vec<u64>) {
+        let mut mark = core::mem::take(&mut self.broad_phase.moved_mark);
+        mark.clear();
+        mark.resize(self.shapes.capacity(), false);
+        for &si in moved {
+            if let Some(m) = mark.get_mut(si as usize) {
+                *m = true;
+            }
+        }
+        let mut fresh: Vec<u64> = Vec::new();
+        let pairs = &self.broad_phase.pairs;
+        self.broad_phase.flat[MOVING_TREE as usize].self_pairs(|a, b| {
+            let moved = |s: u64| mark.get(s as usize).copied().unwrap_or(false);
+            if moved(a) || moved(b) {
+                let key = pair_key(a as u32, b as u32);
+                if !pairs.contains_key(&key) {
+                    fresh.push(key);
+                }
+            }
+        });
+        for key in fresh {
+            let (sa, sb) = ((key >> 32) as u32, key as u32);
+            let (Some(s), Some(o)) = (self.shapes.at(sa), self.shapes.at(sb)) else {
+                continue;
+            };
+            if self
+                .bodies
+                .at(s.body.index)
+                .is_some_and(|body| self.may_pair(s, body, o))
+            {
+                new_pairs.push(key);
+            }
+        }
+        self.broad_phase.moved_mark = mark;
+    }
+
+    /// Whether shapes `s` (of `body`) and `o`, whose boxes overlap and which have no
+    /// contact, make a new pair: other bodies, filters that let them collide, a dynamic
+    /// side, and no joint between the bodies that turns their collision off.
+    #[inline]
+    fn may_pair(&self, s: &ShapeRecord, body: &Body, o: &ShapeRecord) -> bool {
+        if o.body == s.body || !s.filter.should_collide(&o.filter) {
+            return false;
+        }
+        let dynamic = body.is_dynamic() || self.bodies.at(o.body.index).is_some_and(|b| b.is_dynamic());
+        dynamic && (body.joints.is_empty() || !self.joint_blocks_pair(s.body.index, o.body.index))
     }
 
     /// [`World::update_pairs`]' prefetch at the `j`-th moved shape: the shape record
@@ -809,6 +869,11 @@ const NARROW_PREFETCH: usize = 4;
 /// Contact lists up to this long are searched for an existing pair instead of the pair
 /// table (a few keys in one cache line beat a hash probe into a large table).
 const SHORT_CONTACT_LIST: usize = 16;
+
+/// A pair update where at least 1/`JOIN_SHARE` of the moving tree's proxies moved walks
+/// that tree against itself rather than querying it once per moved shape
+/// ([`World::update_pairs`]).
+const JOIN_SHARE: usize = 2;
 
 /// How many moved shapes ahead [`World::update_pairs`] asks for their records.
 const PAIR_PREFETCH: usize = 8;
