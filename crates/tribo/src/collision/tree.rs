@@ -1231,6 +1231,15 @@ impl FlatTree {
     }
 }
 
+/// One side of a pair of subtrees in [`FlatTree::self_pairs`]: a child's box and link,
+/// and where it sits (`2 · node + child`).
+#[derive(Clone, Copy)]
+struct FlatSide {
+    b: Aabb,
+    link: u32,
+    slot: u32,
+}
+
 impl FlatTree {
     /// Calls `callback(data_a, data_b)` once for every pair of leaves whose boxes overlap
     /// (category bits are not tested: the caller filters the pairs), in an order fixed by
@@ -1248,35 +1257,38 @@ impl FlatTree {
         if self.nodes.is_empty() {
             return;
         }
-        // Pending work: internal nodes whose subtree's own pairs remain, and pairs of child
-        // slots (`2 · node + child`) whose boxes overlap, between whose subtrees the pairs
-        // remain. Cross pairs first: they keep the stack short.
+        // Pending work: internal nodes whose subtree's own pairs remain, and pairs of
+        // children whose boxes overlap, between whose subtrees the pairs remain. Cross
+        // pairs first: they keep the stack short.
         let mut inner: Vec<u32> = vec![0];
-        let mut cross: Vec<(u32, u32)> = Vec::new();
+        let mut cross: Vec<(FlatSide, FlatSide)> = Vec::new();
         let overlap =
             |a: Aabb, b: Aabb| !((a.min.x > b.max.x) | (a.min.y > b.max.y) | (b.min.x > a.max.x) | (b.min.y > a.max.y));
-        // A child slot's box, link and user data.
-        let slot = |x: u32| {
-            let (i, c) = ((x >> 1) as usize, (x & 1) as usize);
-            let n = self.nodes.get(i)?;
-            Some((n.boxes[c], n.links[c], self.data.get(i).map_or(0, |d| d[c])))
+        // Child `c` of internal node `i` (its box and link carried along: a popped pair
+        // loads no node; the user data only for a pair of leaves).
+        let side = |n: &FlatNode, i: u32, c: usize| FlatSide {
+            b: n.boxes[c],
+            link: n.links[c],
+            slot: 2 * i + c as u32,
+        };
+        let data = |s: FlatSide| {
+            self.data
+                .get((s.slot >> 1) as usize)
+                .map_or(0, |d| d[(s.slot & 1) as usize])
         };
         loop {
             if let Some((x, y)) = cross.pop() {
-                let (Some((bx, lx, dx)), Some((by, ly, dy))) = (slot(x), slot(y)) else {
-                    continue;
-                };
-                let (leaf_x, leaf_y) = (lx & FLAT_LEAF != 0, ly & FLAT_LEAF != 0);
+                let (leaf_x, leaf_y) = (x.link & FLAT_LEAF != 0, y.link & FLAT_LEAF != 0);
                 if leaf_x && leaf_y {
-                    callback(dx, dy);
+                    callback(data(x), data(y));
                     continue;
                 }
-                let descend_x = !leaf_x && (leaf_y || bx.perimeter() >= by.perimeter());
-                let (k, other, other_box) = if descend_x { (lx, y, by) } else { (ly, x, bx) };
+                let descend_x = !leaf_x && (leaf_y || x.b.perimeter() >= y.b.perimeter());
+                let (k, other) = if descend_x { (x.link, y) } else { (y.link, x) };
                 let Some(n) = self.nodes.get(k as usize) else { continue };
-                for c in 0..2u32 {
-                    if overlap(n.boxes[c as usize], other_box) {
-                        cross.push((2 * k + c, other));
+                for c in 0..2 {
+                    if overlap(n.boxes[c], other.b) {
+                        cross.push((side(n, k, c), other));
                     }
                 }
                 continue;
@@ -1289,7 +1301,7 @@ impl FlatTree {
                 }
             }
             if overlap(n.boxes[0], n.boxes[1]) {
-                cross.push((2 * i, 2 * i + 1));
+                cross.push((side(n, i, 0), side(n, i, 1)));
             }
         }
     }

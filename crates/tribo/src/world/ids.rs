@@ -114,6 +114,14 @@ impl<T> Arena<T> {
         }
     }
 
+    /// The first `lines` cache lines of a slot, asked for (see [`Arena::prefetch`]).
+    #[inline]
+    pub fn prefetch_n(&self, index: u32, lines: usize) {
+        if let Some(slot) = self.slots.get(index as usize) {
+            crate::solver::prefetch_lines(slot, lines);
+        }
+    }
+
     /// The value at a slot index, whatever its generation (internal links).
     #[inline]
     pub fn at(&self, index: u32) -> Option<&T> {

@@ -208,6 +208,9 @@ pub struct World {
     pub(crate) scratch_u32: Vec<u32>,
     pub(crate) scratch_f32: Vec<f32>,
     pub(crate) scratch_mark: Vec<bool>,
+    /// At least 1 in 8 of the contacts the last narrow phase visited were collided in
+    /// full (not recycled): the next one asks for the shapes' geometry ahead too.
+    pub(crate) collided_many: bool,
     /// Scratch: one flag per body slot (active bodies, see `collect_active_contacts`).
     pub(crate) scratch_flags: Vec<bool>,
     /// Scratch of a parallel finalize: per solver slot, whether its body's one shape got
@@ -270,6 +273,7 @@ impl World {
             scratch_u32: Vec::new(),
             scratch_f32: Vec::new(),
             scratch_mark: Vec::new(),
+            collided_many: false,
             scratch_flags: Vec::new(),
             scratch_fitted: Vec::new(),
             scratch_touched: Vec::new(),
