@@ -1261,7 +1261,16 @@ impl FlatTree {
         // children whose boxes overlap, between whose subtrees the pairs remain. Cross
         // pairs first: they keep the stack short.
         let mut inner: Vec<u32> = vec![0];
-        let mut cross: Vec<(FlatSide, FlatSide)> = Vec::new();
+        let blank = FlatSide {
+            b: Aabb::new(Vec2::ZERO, Vec2::ZERO),
+            link: 0,
+            slot: 0,
+        };
+        // The cross pairs' stack: both children of a descent are written and the top
+        // advanced only past those that overlap (which do is data, not a pattern a branch
+        // predictor learns: the branches cost 40 % of the walk).
+        let mut cross: Vec<(FlatSide, FlatSide)> = vec![(blank, blank); 64];
+        let mut top = 0usize;
         let overlap =
             |a: Aabb, b: Aabb| !((a.min.x > b.max.x) | (a.min.y > b.max.y) | (b.min.x > a.max.x) | (b.min.y > a.max.y));
         // Child `c` of internal node `i` (its box and link carried along: a popped pair
@@ -1277,7 +1286,12 @@ impl FlatTree {
                 .map_or(0, |d| d[(s.slot & 1) as usize])
         };
         loop {
-            if let Some((x, y)) = cross.pop() {
+            if cross.len() < top + 2 {
+                cross.resize(2 * cross.len(), (blank, blank));
+            }
+            if let Some(next) = top.checked_sub(1) {
+                top = next;
+                let Some(&(x, y)) = cross.get(top) else { break };
                 let (leaf_x, leaf_y) = (x.link & FLAT_LEAF != 0, y.link & FLAT_LEAF != 0);
                 if leaf_x && leaf_y {
                     callback(data(x), data(y));
@@ -1287,9 +1301,10 @@ impl FlatTree {
                 let (k, other) = if descend_x { (x.link, y) } else { (y.link, x) };
                 let Some(n) = self.nodes.get(k as usize) else { continue };
                 for c in 0..2 {
-                    if overlap(n.boxes[c], other.b) {
-                        cross.push((side(n, k, c), other));
+                    if let Some(e) = cross.get_mut(top) {
+                        *e = (side(n, k, c), other);
                     }
+                    top += overlap(n.boxes[c], other.b) as usize;
                 }
                 continue;
             }
@@ -1300,9 +1315,10 @@ impl FlatTree {
                     inner.push(link);
                 }
             }
-            if overlap(n.boxes[0], n.boxes[1]) {
-                cross.push((side(n, i, 0), side(n, i, 1)));
+            if let Some(e) = cross.get_mut(top) {
+                *e = (side(n, i, 0), side(n, i, 1));
             }
+            top += overlap(n.boxes[0], n.boxes[1]) as usize;
         }
     }
 }
