@@ -72,6 +72,12 @@ pub(crate) struct BroadPhase {
     pub flat: [FlatTree; 2],
     /// Scratch of the pair update: per shape slot, whether its proxy moved.
     pub moved_mark: Vec<bool>,
+    /// Pair updates that walked the moving tree against itself (diagnostics and tests).
+    pub walks: u64,
+    /// Tests: never walk the tree, query per moved shape (the reference the walk must
+    /// match).
+    #[cfg(test)]
+    pub no_walk: bool,
 }
 
 /// A pair update that queries at least 1/`FLAT_QUERY_SHARE` of a tree's proxy count

@@ -1347,6 +1347,67 @@ mod tests {
         }
     }
 
+    /// A shower of spinning boxes thrown down onto a slab between two walls (sleep off).
+    fn shower(n: usize) -> World {
+        let mut w = World::new(WorldDef {
+            enable_sleep: false,
+            ..WorldDef::default()
+        })
+        .unwrap();
+        let ground = w.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
+        for (half, at) in [
+            ((20.0, 1.0), (0.0, 0.0)),
+            ((0.5, 20.0), (-10.0, 20.0)),
+            ((0.5, 20.0), (10.0, 20.0)),
+        ] {
+            let slab = Polygon::new_offset_box(half.0, half.1, Vec2::new(at.0, at.1), 0.0).unwrap();
+            w.create_shape(ground, &ShapeDef::default(), &Shape::Polygon(slab))
+                .unwrap();
+        }
+        let cube = Shape::Polygon(Polygon::new_box(0.3, 0.3).unwrap());
+        for k in 0..n {
+            let (col, row) = ((k % 20) as f32, (k / 20) as f32);
+            let def = BodyDef {
+                linear_velocity: Vec2::new(0.0, -6.0),
+                angular_velocity: if k % 2 == 0 { 3.0 } else { -3.0 },
+                ..BodyDef::dynamic(Vec2::new(-8.5 + 0.9 * col, 1.0 + 0.9 * row))
+            };
+            let b = w.create_body(&def).unwrap();
+            w.create_shape(b, &ShapeDef::default(), &cube).unwrap();
+        }
+        w
+    }
+
+    /// When most moving proxies moved, the pair update walks the moving tree against
+    /// itself (`FlatTree::self_pairs`) instead of querying it once per moved shape: the
+    /// same new pairs, created in the same (sorted) order, so every contact, pose and
+    /// velocity is bit for bit that of a world that always queries.
+    #[test]
+    fn walking_the_tree_finds_the_same_pairs() {
+        let (mut a, mut b) = (shower(300), shower(300));
+        b.broad_phase.no_walk = true;
+        for _ in 0..90 {
+            a.step(1.0 / 60.0).unwrap();
+            b.step(1.0 / 60.0).unwrap();
+        }
+        assert_eq!(b.broad_phase.walks, 0);
+        let walks = a.broad_phase.walks;
+        assert!(walks >= 20, "the tree was walked in {walks} of 90 steps");
+        let pairs = |w: &World| -> Vec<(u32, u32, bool)> {
+            w.contacts
+                .iter()
+                .flatten()
+                .map(|c| (c.shape_a.index, c.shape_b.index, c.touching))
+                .collect()
+        };
+        let (pa, pb) = (pairs(&a), pairs(&b));
+        assert!(pa.iter().filter(|p| p.2).count() > 300, "the boxes have piled up");
+        assert_eq!(pa, pb);
+        for ((_, x), (_, y)) in a.bodies.iter().zip(b.bodies.iter()) {
+            assert_eq!((x.xf, x.v, x.w), (y.xf, y.v, y.w));
+        }
+    }
+
     #[test]
     fn a_slow_shape_keeps_its_unswept_box() {
         // half 0.1 m: thickness 0.1 m, free 0.05 m per step (sweep_free); 2 m/s at 1/60 s

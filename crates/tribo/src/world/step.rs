@@ -110,14 +110,17 @@ impl World {
         // walk down to them (`FlatTree::self_pairs`). The moved shapes then query only the
         // static tree.
         let moving = MOVING_TREE as usize;
-        let join = use_flat[moving] && JOIN_SHARE * moved.len() >= self.broad_phase.trees[moving].proxy_count();
+        let walk = use_flat[moving] && WALK_SHARE * moved.len() >= self.broad_phase.trees[moving].proxy_count();
+        #[cfg(test)]
+        let walk = walk && !self.broad_phase.no_walk;
         let mut new_pairs: Vec<u64> = Vec::new();
-        if join {
-            self.join_moving_pairs(&moved, &mut new_pairs);
+        if walk {
+            self.broad_phase.walks += 1;
+            self.walk_moving_pairs(&moved, &mut new_pairs);
         }
         let mut hits: Vec<u32> = Vec::new();
         // After the walk, the moved shapes only have the static tree left to query.
-        let queries: &[u32] = if join && self.broad_phase.trees[STATIC_TREE as usize].proxy_count() == 0 {
+        let queries: &[u32] = if walk && self.broad_phase.trees[STATIC_TREE as usize].proxy_count() == 0 {
             &[]
         } else {
             &moved
@@ -132,7 +135,7 @@ impl World {
             };
             let trees: &[u8] = if s.tree == STATIC_TREE {
                 &[MOVING_TREE]
-            } else if join {
+            } else if walk {
                 &[STATIC_TREE]
             } else {
                 &[MOVING_TREE, STATIC_TREE]
@@ -184,7 +187,7 @@ impl World {
     /// `new_pairs`: one walk of the tree's [`FlatTree`] copy against itself (current: see
     /// [`World::update_pairs`]); a pair with a contact is found in the pair table without
     /// reading either shape's record.
-    fn join_moving_pairs(&mut self, moved: &[u32], new_pairs: &mut Vec<u64>) {
+    fn walk_moving_pairs(&mut self, moved: &[u32], new_pairs: &mut Vec<u64>) {
         let mut mark = core::mem::take(&mut self.broad_phase.moved_mark);
         mark.clear();
         mark.resize(self.shapes.capacity(), false);
@@ -895,10 +898,10 @@ const NARROW_PREFETCH: usize = 4;
 /// table (a few keys in one cache line beat a hash probe into a large table).
 const SHORT_CONTACT_LIST: usize = 16;
 
-/// A pair update where at least 1/`JOIN_SHARE` of the moving tree's proxies moved walks
+/// A pair update where at least 1/`WALK_SHARE` of the moving tree's proxies moved walks
 /// that tree against itself rather than querying it once per moved shape
 /// ([`World::update_pairs`]).
-const JOIN_SHARE: usize = 2;
+const WALK_SHARE: usize = 2;
 
 /// How many moved shapes ahead [`World::update_pairs`] asks for their records.
 const PAIR_PREFETCH: usize = 8;
