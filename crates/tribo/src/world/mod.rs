@@ -1258,14 +1258,20 @@ mod tests {
         g.aabb(Transform { p: xf.p + d, q: xf.q })
     }
 
-    /// A pyramid of `rows` rows of 1 m boxes on the ground, sleep off.
-    fn pyramid(rows: usize) -> World {
+    /// A world without sleep, and its ground body (fixed at y = −1 m, no shape yet).
+    fn sleepless_with_ground() -> (World, BodyId) {
         let mut w = World::new(WorldDef {
             enable_sleep: false,
             ..WorldDef::default()
         })
         .unwrap();
         let ground = w.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
+        (w, ground)
+    }
+
+    /// A pyramid of `rows` rows of 1 m boxes on the ground, sleep off.
+    fn pyramid(rows: usize) -> World {
+        let (mut w, ground) = sleepless_with_ground();
         let slab = Shape::Polygon(Polygon::new_box(200.0, 1.0).unwrap());
         w.create_shape(ground, &ShapeDef::default(), &slab).unwrap();
         let cube = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
@@ -1349,12 +1355,7 @@ mod tests {
 
     /// A shower of spinning boxes thrown down onto a slab between two walls (sleep off).
     fn shower(n: usize) -> World {
-        let mut w = World::new(WorldDef {
-            enable_sleep: false,
-            ..WorldDef::default()
-        })
-        .unwrap();
-        let ground = w.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
+        let (mut w, ground) = sleepless_with_ground();
         for (half, at) in [
             ((20.0, 1.0), (0.0, 0.0)),
             ((0.5, 20.0), (-10.0, 20.0)),
