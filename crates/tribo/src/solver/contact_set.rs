@@ -224,9 +224,9 @@ pub(crate) struct ContactSolver {
     /// The contact of each candidate ([`ContactSolver::solved_order`] reads these 4 bytes,
     /// not the candidates' records).
     contact_of: Vec<u32>,
-    /// Last step's candidates as the colouring left them: contact, key with the colour it
-    /// was given and without [`FAST`] ([`ContactSolver::same_layout`]).
-    last_keys: Vec<(u32, ColourKey)>,
+    /// Last step's candidates' keys as the colouring left them (parallel to `contact_of`):
+    /// with the colour each was given and without [`FAST`] ([`ContactSolver::same_layout`]).
+    last_keys: Vec<ColourKey>,
     /// Last step's layout had no overflow (only then may the next step keep it).
     pub(crate) layout_kept: bool,
     /// Steps that kept the last step's layout (for tests and diagnostics).
@@ -345,8 +345,7 @@ impl ContactSolver {
     ) {
         self.overflow.clear();
         self.groups.clear();
-        let soft = StepSoftness::new(ctx);
-        self.soft = soft;
+        self.soft = StepSoftness::new(ctx);
         let mut light: Vec<(u32, u32)> = Vec::new(); // (light body state, sweeps)
         if self.same_layout(candidates, sims, &mut light) {
             self.kept_layouts += 1;
@@ -462,14 +461,11 @@ impl ContactSolver {
                     fast_counts[k] += (key.flags & FAST != 0) as u32;
                     any_restitution |= key.flags & KEY_RESTITUTION != 0;
                     self.colours.push(k as u8 | (key.flags & (FAST | FRESH)));
-                    self.last_keys.push((
-                        contact,
-                        ColourKey {
-                            colour: k as u8,
-                            flags: key.flags & !FAST,
-                            ..*key
-                        },
-                    ));
+                    self.last_keys.push(ColourKey {
+                        colour: k as u8,
+                        flags: key.flags & !FAST,
+                        ..*key
+                    });
                 }
                 None => {
                     self.colours.push(OVERFLOW);
@@ -555,10 +551,12 @@ impl ContactSolver {
     /// fails at once. `light` gets the light bodies under heavy ones, as the colouring
     /// collects them.
     fn same_layout(&self, candidates: Candidates<'_>, sims: &[BodySim], light: &mut Vec<(u32, u32)>) -> bool {
-        if !self.layout_kept || self.last_keys.len() != candidates.list.len() {
+        let n = candidates.list.len();
+        if !self.layout_kept || self.last_keys.len() != n || self.contact_of.len() != n {
             return false;
         }
-        for (i, (&contact, &(last_contact, last))) in candidates.list.iter().zip(&self.last_keys).enumerate() {
+        let before = candidates.list.iter().zip(self.contact_of.iter().zip(&self.last_keys));
+        for (i, (&contact, (&last_contact, last))) in before.enumerate() {
             let Some(key) = candidates.keys.get(contact as usize) else {
                 return false;
             };
