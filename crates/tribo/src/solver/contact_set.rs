@@ -85,7 +85,7 @@ impl Candidate {
             index_b: b.index_b,
             colour,
             flags: flag(fast_first(input), FAST)
-                | flag(input.has_fresh_point(), FRESH)
+                | flag(input.may_be_new_resting(), FRESH)
                 | flag(b.index_a != 0 && dynamic_side(b.inv_mass_a, b.inv_i_a), KEY_DYNAMIC_A)
                 | flag(b.index_b != 0 && dynamic_side(b.inv_mass_b, b.inv_i_b), KEY_DYNAMIC_B)
                 | flag(mass_ratio(b).is_some(), KEY_RATIO)
@@ -121,6 +121,14 @@ pub(crate) struct ColourKey {
     colour: u8,
     /// [`FAST`], [`FRESH`], [`KEY_DYNAMIC_A`], [`KEY_DYNAMIC_B`], [`KEY_RATIO`].
     flags: u8,
+}
+
+impl ColourKey {
+    /// The solver slots of the constraint's two bodies (0: a static body).
+    #[inline]
+    pub fn slots(&self) -> (u32, u32) {
+        (self.index_a, self.index_b)
+    }
 }
 
 /// Flag of a [`ColourKey`]: side A is a moving body (takes a colour).
@@ -202,7 +210,8 @@ pub(crate) struct ContactSolver {
     cold: Vec<WideCold>,
     /// Constraints that found no colour, whole (solved first in each pass).
     overflow: Vec<ContactConstraint>,
-    /// Constraints with a point new this step.
+    /// Constraints whose points are all new this step and touching (those the warm-start
+    /// estimate may take).
     fresh: Vec<Slot>,
     /// Gravity or a force acts on some body this step ([`super::any_load`]): the helpers
     /// for carrying loads (estimate, mass-ratio groups) run only then.
@@ -310,7 +319,8 @@ const OVERFLOW: u8 = u8::MAX;
 
 /// Flag in a constraint's colour byte: it goes to the front of its colour ([`fast_first`]).
 const FAST: u8 = 0x40;
-/// Flag in a constraint's colour byte: it has a point new this step ([`Candidate`]).
+/// Flag in a constraint's colour byte: all its points are new this step and touching
+/// (`ContactInput::may_be_new_resting`).
 const FRESH: u8 = 0x20;
 const _: () = assert!(COLORS <= FRESH as usize);
 
@@ -511,7 +521,7 @@ impl ContactSolver {
                 let Some(cand) = candidates.get(i) else { continue };
                 let b = &cand.bodies;
                 let cc = build_constraint(cand.contact, &cand.input, b, self.up, &soft, ctx, states);
-                if cand.input.has_fresh_point() {
+                if cand.input.may_be_new_resting() {
                     self.fresh.push(Slot::Overflow(self.overflow.len() as u32));
                 }
                 self.overflow.push(cc);

@@ -201,9 +201,16 @@ impl ContactInput {
         rolling_impulse: 0.0,
     };
 
-    /// Whether a point is new this step (the warm-start estimate looks at the constraint).
-    pub fn has_fresh_point(&self) -> bool {
-        self.points[..self.count.min(2)].iter().any(|p| p.fresh)
+    /// Whether the contact may be new and resting ([`is_new_resting`], which also needs the
+    /// approach speed): every point new this step and touching. Only these constraints are
+    /// handed to the warm-start estimate; a contact with one new point beside an old one,
+    /// or a speculative one, is not (tumbler: most of its new points are such).
+    pub fn may_be_new_resting(&self) -> bool {
+        let points = &self.points[..self.count.min(2)];
+        !points.is_empty()
+            && points
+                .iter()
+                .all(|p| p.fresh && p.separation <= crate::geometry::LINEAR_SLOP)
     }
 
     /// Writes what building a constraint reads of contact `c` in place (no copy).

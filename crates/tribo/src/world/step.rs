@@ -666,6 +666,23 @@ impl World {
         self.profile.store = lap.lap();
     }
 
+    /// [`World::finalize`]'s prefetch at solver slot `k`: the body record
+    /// [`FINALIZE_PREFETCH`] slots ahead, the first shape of the body half as far ahead
+    /// (its body record is then cached).
+    #[inline]
+    fn prefetch_finalize(&self, k: usize) {
+        if let Some(far) = self.sims.get(k + FINALIZE_PREFETCH) {
+            self.bodies.prefetch_n(far.body, 4);
+        }
+        let mid = self
+            .sims
+            .get(k + FINALIZE_PREFETCH / 2)
+            .and_then(|s| self.bodies.at(s.body));
+        if let Some(sid) = mid.and_then(|b| b.shapes.first()) {
+            self.shapes.prefetch_n(sid.index, 4);
+        }
+    }
+
     /// Writes the solver's motion back to the bodies, refreshes fat boxes and sleep timers.
     fn finalize(&mut self, dt: f32, parallel: bool) {
         // Poses and sleep timers, body by body (in parallel: each body writes itself).
@@ -726,13 +743,24 @@ impl World {
         touched.clear();
         touched.resize(self.states.len(), false);
         let fast = any_fast.load(core::sync::atomic::Ordering::Relaxed);
+        // The solved contacts' slots are in their colouring keys (12 bytes each, not the
+        // contact records' lines: tumbler's loop stalled on those); the solved contacts are
+        // the touching ones in the same order, less those without an awake dynamic side,
+        // whose records are read.
+        let mut solved = self.solver_contacts.iter().peekable();
         for &ci in self.touching_contacts.iter().filter(|_| fast) {
-            if let Some(Some(c)) = self.contacts.get(ci as usize) {
-                for body in [c.body_a, c.body_b] {
-                    if let Some(slot) = self.solver_bodies.get(body as usize).map(|sb| sb.index as usize) {
-                        if let Some(t) = touched.get_mut(slot) {
-                            *t = true;
-                        }
+            let pair = if solved.next_if_eq(&&ci).is_some() {
+                self.colour_keys.get(ci as usize).map(|k| k.slots())
+            } else {
+                self.contacts.get(ci as usize).and_then(Option::as_ref).map(|c| {
+                    let slot = |body: u32| self.solver_bodies.get(body as usize).map_or(0, |sb| sb.index);
+                    (slot(c.body_a), slot(c.body_b))
+                })
+            };
+            if let Some((a, b)) = pair {
+                for slot in [a, b] {
+                    if let Some(t) = touched.get_mut(slot as usize) {
+                        *t = true;
                     }
                 }
             }
@@ -780,6 +808,7 @@ impl World {
             if fitted.get_mut(k).is_some_and(|f| *f.get_mut()) {
                 continue; // fitted above
             }
+            self.prefetch_finalize(k);
             let bi = self.sims[k].body;
             let Some(b) = self.bodies.at_mut(bi) else { continue };
             if b.non_finite {
@@ -905,6 +934,9 @@ const WALK_SHARE: usize = 2;
 
 /// How many moved shapes ahead [`World::update_pairs`] asks for their records.
 const PAIR_PREFETCH: usize = 8;
+
+/// How many solver slots ahead [`World::finalize`] asks for the body records.
+const FINALIZE_PREFETCH: usize = 8;
 
 /// Writes the solver's input and colouring key of a touching contact with an awake dynamic
 /// side into `out` and `key`; false (nothing written) otherwise.
