@@ -684,100 +684,42 @@ impl World {
     }
 
     /// Writes the solver's motion back to the bodies, refreshes fat boxes and sleep timers.
+    ///
+    /// Per body, in solver order: its pose and sleep timer ([`advance_body`]), then its
+    /// boxes in the trees ([`World::refresh_body_proxies`]; the trees are shared, so this
+    /// part is serial and in that order). A box is swept only when the body moved, or will
+    /// move, more than the speculative distance ([`boxes_care`]) and touched nothing, so
+    /// which bodies touched something is found only when some body is that fast.
     fn finalize(&mut self, dt: f32, parallel: bool) {
-        // Poses and sleep timers, body by body (in parallel: each body writes itself).
+        if !parallel {
+            self.finalize_one_thread(dt);
+            return;
+        }
+        // Poses and sleep timers in parallel: each body writes itself.
         let (states, sleep_on, solver_bodies) = (&self.states, self.def.enable_sleep, &self.solver_bodies);
-        // Whether any body moved, or will move, more than the speculative distance per step:
-        // only then can a box be swept or a swept body need the continuous check, and only
-        // then does it matter which bodies touched something.
+        let limit = self.def.max_linear_speed;
         let any_fast = core::sync::atomic::AtomicBool::new(false);
         self.bodies.for_each_live_mut(parallel, BODY_CHUNK, |bi, b| {
             let index = solver_bodies.get(bi as usize).map_or(0, |sb| sb.index);
-            if index == 0 {
-                return;
-            }
-            let s = states[index as usize];
-            b.force = Vec2::ZERO;
-            b.torque = 0.0;
-            let finite =
-                s.v.is_finite() && s.w.is_finite() && s.dp.is_finite() && s.dq.c.is_finite() && s.dq.s.is_finite();
-            if !finite {
-                // NaN born inside the simulation: freeze the body at its last good pose
-                // and report it (below) rather than spreading the NaN.
-                b.v = Vec2::ZERO;
-                b.w = 0.0;
-                b.non_finite = true;
-                return;
-            }
-            b.v = s.v;
-            b.w = s.w;
-            if s.v.length() * dt > SPECULATIVE_DISTANCE || s.dp.length() > SPECULATIVE_DISTANCE {
-                any_fast.store(true, core::sync::atomic::Ordering::Relaxed);
-            }
-            b.center0 = b.center;
-            b.q0 = b.xf.q;
-            b.center += s.dp;
-            let q = s.dq.mul(b.xf.q);
-            // Renormalise against slow drift of |q| over many steps.
-            let mag = (q.c * q.c + q.s * q.s).sqrt();
-            b.xf.q = Rot {
-                c: q.c / mag,
-                s: q.s / mag,
-            };
-            b.xf.p = b.center - b.xf.q.rotate(b.local_center);
-            // Sleep timer (Box2D's metric: |v| + |ω|·extent against the threshold).
-            if sleep_on && b.enable_sleep && b.body_type == BodyType::Dynamic {
-                let speed = b.v.length() + b.w.abs() * b.max_extent;
-                if speed > b.sleep_threshold {
-                    b.sleep_time = 0.0;
-                } else {
-                    b.sleep_time += dt;
+            if let Some(&s) = states.get(index as usize).filter(|_| index != 0) {
+                if advance_body(b, s, dt, sleep_on) && boxes_care(b, dt, limit) {
+                    any_fast.store(true, core::sync::atomic::Ordering::Relaxed);
                 }
-            } else {
-                b.sleep_time = 0.0;
             }
         });
-        // Which solver slots touched something this step: their boxes are not swept
-        // (broad_phase::sweep_free), unless the body is a bullet.
         let mut touched = core::mem::take(&mut self.scratch_touched);
-        touched.clear();
-        touched.resize(self.states.len(), false);
-        let fast = any_fast.load(core::sync::atomic::Ordering::Relaxed);
-        // The solved contacts' slots are in their colouring keys (12 bytes each, not the
-        // contact records' lines: tumbler's loop stalled on those); the solved contacts are
-        // the touching ones in the same order, less those without an awake dynamic side,
-        // whose records are read.
-        let mut solved = self.solver_contacts.iter().peekable();
-        for &ci in self.touching_contacts.iter().filter(|_| fast) {
-            let pair = if solved.next_if_eq(&&ci).is_some() {
-                self.colour_keys.get(ci as usize).map(|k| k.slots())
-            } else {
-                self.contacts.get(ci as usize).and_then(Option::as_ref).map(|c| {
-                    let slot = |body: u32| self.solver_bodies.get(body as usize).map_or(0, |sb| sb.index);
-                    (slot(c.body_a), slot(c.body_b))
-                })
-            };
-            if let Some((a, b)) = pair {
-                for slot in [a, b] {
-                    if let Some(t) = touched.get_mut(slot as usize) {
-                        *t = true;
-                    }
-                }
-            }
-        }
-        // With threads, the boxes of one-shape bodies are computed shape by shape in
-        // parallel; a box that stays inside its fat box is stored there (a shape writes only
-        // itself and its bounds) and its body flagged. Only the other bodies go through the
-        // serial pass below, which moves tree proxies (it used to store every box:
-        // many_pyramids' finalize took as long on two threads as on one). One thread keeps
-        // the serial pass alone: in moving scenes many boxes leave their fat boxes and were
-        // computed twice (tumbler's finalize / relax 0.82 -> 0.95, rain's 0.91 -> 1.05).
+        self.touched_slots(any_fast.into_inner(), &mut touched);
+        // The boxes of one-shape bodies are computed shape by shape in parallel; a box that
+        // stays inside its fat box is stored there (a shape writes only itself and its
+        // bounds) and its body flagged. Only the other bodies go through the serial pass
+        // below, which moves tree proxies (it used to store every box: many_pyramids'
+        // finalize took as long on two threads as on one).
         let mut fitted = core::mem::take(&mut self.scratch_fitted);
         fitted.clear();
-        if parallel && dt > 0.0 {
+        if dt > 0.0 {
             use core::sync::atomic::{AtomicBool, Ordering::Relaxed};
             fitted.resize_with(self.states.len(), || AtomicBool::new(false));
-            let (bodies, solver_bodies, limit) = (&self.bodies, &self.solver_bodies, self.def.max_linear_speed);
+            let (bodies, solver_bodies) = (&self.bodies, &self.solver_bodies);
             let (touched, flags) = (&touched, &fitted);
             self.shapes
                 .for_each_live_mut_with(parallel, BODY_CHUNK, &mut self.shape_bounds, |_, s, bounds| {
@@ -803,28 +745,91 @@ impl World {
                     }
                 });
         }
-        // The other bodies' fat boxes and the trees, in solver order (the trees are shared).
+        // The other bodies' fat boxes and the trees, in solver order.
         for k in 1..self.states.len() {
             if fitted.get_mut(k).is_some_and(|f| *f.get_mut()) {
                 continue; // fitted above
             }
             self.prefetch_finalize(k);
             let bi = self.sims[k].body;
-            let Some(b) = self.bodies.at_mut(bi) else { continue };
-            if b.non_finite {
-                b.non_finite = false;
-                let id = BodyId {
-                    index: bi,
-                    generation: self.bodies.generation(bi),
-                };
-                self.non_finite.push(id);
-                continue;
+            if let Some(bullet) = self.finite_or_reported(bi) {
+                self.refresh_body_proxies(bi, dt, bullet || !touched[k]);
             }
-            let sweep = b.bullet || !touched[k];
-            self.refresh_body_proxies(bi, dt, sweep);
         }
         self.scratch_fitted = fitted;
         self.scratch_touched = touched;
+    }
+
+    /// [`World::finalize`] on one thread: each body's pose and then at once its boxes, while
+    /// its record is in cache (two passes over the bodies had cost large_pyramid's finalize
+    /// a second read of 5 000 records), in solver order as with threads. Which bodies
+    /// touched something is found when the first body whose boxes care comes.
+    fn finalize_one_thread(&mut self, dt: f32) {
+        let (sleep_on, limit) = (self.def.enable_sleep, self.def.max_linear_speed);
+        let mut touched = core::mem::take(&mut self.scratch_touched);
+        let mut found = false;
+        for k in 1..self.states.len() {
+            self.prefetch_finalize(k);
+            let (bi, s) = (self.sims[k].body, self.states[k]);
+            let Some(b) = self.bodies.at_mut(bi) else { continue };
+            let care = advance_body(b, s, dt, sleep_on) && boxes_care(b, dt, limit);
+            let Some(bullet) = self.finite_or_reported(bi) else {
+                continue;
+            };
+            if care && !found {
+                self.touched_slots(true, &mut touched);
+                found = true;
+            }
+            // A body whose boxes do not care is not swept either way.
+            let sweep = bullet || !(care && touched[k]);
+            self.refresh_body_proxies(bi, dt, sweep);
+        }
+        self.scratch_touched = touched;
+    }
+
+    /// Whether body `bi` is a bullet, or `None` when its state went non-finite in this
+    /// step's solve: it is then reported (`World::non_finite`) and keeps its boxes.
+    fn finite_or_reported(&mut self, bi: u32) -> Option<bool> {
+        let b = self.bodies.at_mut(bi)?;
+        if !b.non_finite {
+            return Some(b.bullet);
+        }
+        b.non_finite = false;
+        let id = BodyId {
+            index: bi,
+            generation: self.bodies.generation(bi),
+        };
+        self.non_finite.push(id);
+        None
+    }
+
+    /// Which solver slots touched something this step (when `any`; else none): their boxes
+    /// are not swept (broad_phase::sweep_free), unless the body is a bullet.
+    fn touched_slots(&self, any: bool, touched: &mut Vec<bool>) {
+        touched.clear();
+        touched.resize(self.states.len(), false);
+        // The solved contacts' slots are in their colouring keys (12 bytes each, not the
+        // contact records' lines: tumbler's loop stalled on those); the solved contacts are
+        // the touching ones in the same order, less those without an awake dynamic side,
+        // whose records are read.
+        let mut solved = self.solver_contacts.iter().peekable();
+        for &ci in self.touching_contacts.iter().filter(|_| any) {
+            let pair = if solved.next_if_eq(&&ci).is_some() {
+                self.colour_keys.get(ci as usize).map(|k| k.slots())
+            } else {
+                self.contacts.get(ci as usize).and_then(Option::as_ref).map(|c| {
+                    let slot = |body: u32| self.solver_bodies.get(body as usize).map_or(0, |sb| sb.index);
+                    (slot(c.body_a), slot(c.body_b))
+                })
+            };
+            if let Some((a, b)) = pair {
+                for slot in [a, b] {
+                    if let Some(t) = touched.get_mut(slot as usize) {
+                        *t = true;
+                    }
+                }
+            }
+        }
     }
 
     /// Islands (awake dynamic bodies linked by touching contacts) whose every body has
@@ -934,6 +939,57 @@ const WALK_SHARE: usize = 2;
 
 /// How many moved shapes ahead [`World::update_pairs`] asks for their records.
 const PAIR_PREFETCH: usize = 8;
+
+/// Writes a body's solver state `s` (after a step of `dt` [s]) into its record: velocity,
+/// pose from the step's motion, and sleep timer. Returns false, leaving the body at its
+/// last good pose and flagged `non_finite`, when the state is not finite.
+fn advance_body(b: &mut Body, s: BodyState, dt: f32, sleep_on: bool) -> bool {
+    b.force = Vec2::ZERO;
+    b.torque = 0.0;
+    let finite = s.v.is_finite() && s.w.is_finite() && s.dp.is_finite() && s.dq.c.is_finite() && s.dq.s.is_finite();
+    if !finite {
+        // NaN born inside the simulation: freeze the body at its last good pose and report
+        // it (`World::finalize`) rather than spreading the NaN.
+        b.v = Vec2::ZERO;
+        b.w = 0.0;
+        b.non_finite = true;
+        return false;
+    }
+    b.v = s.v;
+    b.w = s.w;
+    b.center0 = b.center;
+    b.q0 = b.xf.q;
+    b.center += s.dp;
+    let q = s.dq.mul(b.xf.q);
+    // Renormalise against slow drift of |q| over many steps.
+    let mag = (q.c * q.c + q.s * q.s).sqrt();
+    b.xf.q = Rot {
+        c: q.c / mag,
+        s: q.s / mag,
+    };
+    b.xf.p = b.center - b.xf.q.rotate(b.local_center);
+    // Sleep timer (Box2D's metric: |v| + |ω|·extent against the threshold).
+    if sleep_on && b.enable_sleep && b.body_type == BodyType::Dynamic {
+        let speed = b.v.length() + b.w.abs() * b.max_extent;
+        if speed > b.sleep_threshold {
+            b.sleep_time = 0.0;
+        } else {
+            b.sleep_time += dt;
+        }
+    } else {
+        b.sleep_time = 0.0;
+    }
+    true
+}
+
+/// Whether a body's boxes depend on the sweep rule: it moved this step, or will move at
+/// its speed (capped at `limit` [m/s]), more than the speculative distance. Otherwise its
+/// next box is not swept whatever the rule ([`next_box`]: the sweep starts beyond
+/// `sweep_free`, which is at least that distance, and so does the check of a swept body).
+fn boxes_care(b: &Body, dt: f32, limit: f32) -> bool {
+    box_velocity(b, limit).length() * dt > SPECULATIVE_DISTANCE
+        || (b.center - b.center0).length() > SPECULATIVE_DISTANCE
+}
 
 /// How many solver slots ahead [`World::finalize`] asks for the body records.
 const FINALIZE_PREFETCH: usize = 8;
