@@ -439,6 +439,9 @@ pub(crate) struct BodySim {
     pub angular_damping: f32,
     /// Body slot index in the world.
     pub body: u32,
+    /// Slot index of the body's first shape (`u32::MAX`: none; `World::finalize` asks
+    /// for its record ahead without reading the body's shape list).
+    pub shape: u32,
     /// The body has joints (a motor may drive it with any torque: its contacts get no
     /// mass-ratio sweeps, see `contact_set`).
     pub jointed: bool,

@@ -211,8 +211,11 @@ pub struct World {
     /// At least 1 in 8 of the contacts the last narrow phase visited were collided in
     /// full (not recycled): the next one asks for the shapes' geometry ahead too.
     pub(crate) collided_many: bool,
-    /// Scratch: one flag per body slot (active bodies, see `collect_active_contacts`).
+    /// One flag per body slot: awake and not static (set by `prepare_bodies`, read by
+    /// the narrow phase's `collect_active_contacts`).
     pub(crate) scratch_flags: Vec<bool>,
+    /// More than half the bodies are awake and not static (set by `prepare_bodies`).
+    pub(crate) mostly_awake: bool,
     /// Scratch of a parallel finalize: per solver slot, whether its body's one shape got
     /// its next box (inside the fat box) in the parallel pass (see `World::finalize`).
     pub(crate) scratch_fitted: Vec<core::sync::atomic::AtomicBool>,
@@ -275,6 +278,7 @@ impl World {
             scratch_mark: Vec::new(),
             collided_many: false,
             scratch_flags: Vec::new(),
+            mostly_awake: false,
             scratch_fitted: Vec::new(),
             scratch_touched: Vec::new(),
             scratch_found: Vec::new(),

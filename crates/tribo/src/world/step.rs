@@ -337,7 +337,7 @@ impl World {
     /// step that wakes a sleeping island makes them and the candidates again.
     fn collide(&mut self, dt: f32, parallel: bool) {
         let mut active = core::mem::take(&mut self.active_contacts);
-        let mut flags = core::mem::take(&mut self.scratch_flags);
+        let flags = core::mem::take(&mut self.scratch_flags);
         let mut outcomes = core::mem::take(&mut self.outcomes);
         let mut candidates = core::mem::take(&mut self.candidates);
         let mut keys = core::mem::take(&mut self.colour_keys);
@@ -360,7 +360,7 @@ impl World {
                 && candidate(ci as u32, c, solver_bodies, cand, key);
             *out = (outcome, solvable);
         };
-        let mostly_awake = self.active_body_flags(&mut flags);
+        let mostly_awake = self.mostly_awake;
         let mut mark = core::mem::take(&mut self.scratch_mark);
         mark.clear();
         if mostly_awake {
@@ -497,9 +497,8 @@ impl World {
             // change) and their contacts join the solve with their last manifolds: the
             // entries and every touching contact's candidate are made again.
             self.prepare_bodies();
-            let mut flags = core::mem::take(&mut self.scratch_flags);
-            let mostly_awake = self.active_body_flags(&mut flags);
-            self.collect_active_contacts(&mut touching, &flags, mostly_awake, true);
+            let flags = core::mem::take(&mut self.scratch_flags);
+            self.collect_active_contacts(&mut touching, &flags, self.mostly_awake, true);
             self.scratch_flags = flags;
             solvable.clear();
             for &ci in &touching {
@@ -518,27 +517,10 @@ impl World {
         self.colour_keys = keys;
     }
 
-    /// One flag per body slot: awake and not static (read in body order, so the contacts
-    /// then test two bytes instead of two body records). Returns whether most bodies are
-    /// awake (then one pass over the contacts in memory order beats chasing the awake
-    /// bodies' contact lists).
-    fn active_body_flags(&self, flags: &mut Vec<bool>) -> bool {
-        flags.clear();
-        flags.resize(self.bodies.capacity(), false);
-        let mut awake = 0usize;
-        for (bi, b) in self.bodies.iter() {
-            if b.awake && b.body_type != BodyType::Static {
-                flags[bi as usize] = true;
-                awake += 1;
-            }
-        }
-        2 * awake > self.bodies.len()
-    }
-
     /// The contacts with an awake moving body (only touching ones if `touching_only`), in
     /// contact order: found through the awake bodies' contact lists, so sleeping islands
-    /// cost nothing. `flags` and `mostly_awake`: [`World::active_body_flags`], just
-    /// computed.
+    /// cost nothing. `flags` and `mostly_awake`: [`World::scratch_flags`] and
+    /// [`World::mostly_awake`], as [`World::prepare_bodies`] left them.
     fn collect_active_contacts(&self, out: &mut Vec<u32>, flags: &[bool], mostly_awake: bool, touching_only: bool) {
         out.clear();
         let active = |bi: u32| flags.get(bi as usize).copied().unwrap_or(false);
@@ -583,10 +565,21 @@ impl World {
         self.states.push(BodyState::default()); // index 0: every static body
         self.sims.push(BodySim::default());
         let capacity = self.bodies.capacity();
-        self.solver_bodies.clear();
+        // Every entry is written below (an empty slot's too), so the arrays are only
+        // resized, not cleared first: many_pyramids' 22 000 entries are 1.4 MB.
         self.solver_bodies.resize(capacity, SolverBody::default());
+        self.solver_bodies.truncate(capacity);
+        self.scratch_flags.resize(capacity, false);
+        self.scratch_flags.truncate(capacity);
         for bi in 0..capacity as u32 {
-            let (Some(b), Some(sb)) = (self.bodies.at(bi), self.solver_bodies.get_mut(bi as usize)) else {
+            let Some(sb) = self.solver_bodies.get_mut(bi as usize) else {
+                continue;
+            };
+            if let Some(f) = self.scratch_flags.get_mut(bi as usize) {
+                *f = false;
+            }
+            let Some(b) = self.bodies.at(bi) else {
+                *sb = SolverBody::default();
                 continue;
             };
             *sb = SolverBody {
@@ -603,6 +596,9 @@ impl World {
             };
             if !b.awake || b.body_type == BodyType::Static {
                 continue;
+            }
+            if let Some(f) = self.scratch_flags.get_mut(bi as usize) {
+                *f = true;
             }
             sb.index = self.states.len() as u32;
             sb.awake_dynamic = b.is_dynamic();
@@ -628,9 +624,13 @@ impl World {
                 linear_damping: if dynamic { b.linear_damping } else { 0.0 },
                 angular_damping: if dynamic { b.angular_damping } else { 0.0 },
                 body: bi,
+                shape: b.shapes.first().map_or(u32::MAX, |id| id.index),
                 jointed: !b.joints.is_empty(),
             });
         }
+        // Bodies whose contacts the narrow phase visits (awake and not static): most of
+        // them, or few (see `World::collide`).
+        self.mostly_awake = 2 * (self.states.len() - 1) > self.bodies.len();
     }
 
     /// Builds the solver's constraints from the candidates the narrow phase made, runs the
@@ -667,19 +667,14 @@ impl World {
     }
 
     /// [`World::finalize`]'s prefetch at solver slot `k`: the body record
-    /// [`FINALIZE_PREFETCH`] slots ahead, the first shape of the body half as far ahead
-    /// (its body record is then cached).
+    /// [`FINALIZE_PREFETCH`] slots ahead, the first shape of the body half as far ahead.
     #[inline]
     fn prefetch_finalize(&self, k: usize) {
         if let Some(far) = self.sims.get(k + FINALIZE_PREFETCH) {
             self.bodies.prefetch_n(far.body, 4);
         }
-        let mid = self
-            .sims
-            .get(k + FINALIZE_PREFETCH / 2)
-            .and_then(|s| self.bodies.at(s.body));
-        if let Some(sid) = mid.and_then(|b| b.shapes.first()) {
-            self.shapes.prefetch_n(sid.index, 4);
+        if let Some(mid) = self.sims.get(k + FINALIZE_PREFETCH / 2) {
+            self.shapes.prefetch_n(mid.shape, 4);
         }
     }
 
