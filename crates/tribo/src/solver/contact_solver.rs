@@ -207,10 +207,7 @@ impl ContactInput {
     /// or a speculative one, is not (tumbler: most of its new points are such).
     pub fn may_be_new_resting(&self) -> bool {
         let points = &self.points[..self.count.min(2)];
-        !points.is_empty()
-            && points
-                .iter()
-                .all(|p| p.fresh && p.separation <= crate::geometry::LINEAR_SLOP)
+        !points.is_empty() && points.iter().all(|p| fresh_touching(p.fresh, p.separation))
     }
 
     /// Writes what building a constraint reads of contact `c` in place (no copy).
@@ -395,13 +392,21 @@ pub(crate) fn record_approach<S: StateRead>(cc: &mut ContactConstraint, states: 
     }
 }
 
+/// Whether a point is new this step and touching (separation [m] within the slop): what
+/// every point of a new resting contact is ([`ContactInput::may_be_new_resting`] before
+/// the build, [`is_new_resting`] after).
+#[inline]
+fn fresh_touching(fresh: bool, separation: f32) -> bool {
+    fresh && separation <= crate::geometry::LINEAR_SLOP
+}
+
 /// Whether a constraint is new and resting: every point fresh, touching and not hitting
 /// (after [`record_approach`]).
 pub(crate) fn is_new_resting(cc: &ContactConstraint) -> bool {
     cc.count > 0
         && cc.points[..cc.count]
             .iter()
-            .all(|p| p.fresh && p.base_separation <= crate::geometry::LINEAR_SLOP && p.substep_vn > -RESTING_SPEED)
+            .all(|p| fresh_touching(p.fresh, p.base_separation) && p.substep_vn > -RESTING_SPEED)
 }
 
 /// Estimates warm-start impulses for new resting constraints (`subset`) by rigid sweeps

@@ -761,6 +761,7 @@ impl World {
     /// touched something is found when the first body whose boxes care comes.
     fn finalize_one_thread(&mut self, dt: f32) {
         let (sleep_on, limit) = (self.def.enable_sleep, self.def.max_linear_speed);
+        // Filled when the first body whose boxes care comes; read only for such bodies.
         let mut touched = core::mem::take(&mut self.scratch_touched);
         let mut found = false;
         for k in 1..self.states.len() {
@@ -803,12 +804,15 @@ impl World {
     fn touched_slots(&self, any: bool, touched: &mut Vec<bool>) {
         touched.clear();
         touched.resize(self.states.len(), false);
+        if !any {
+            return;
+        }
         // The solved contacts' slots are in their colouring keys (12 bytes each, not the
         // contact records' lines: tumbler's loop stalled on those); the solved contacts are
         // the touching ones in the same order, less those without an awake dynamic side,
         // whose records are read.
         let mut solved = self.solver_contacts.iter().peekable();
-        for &ci in self.touching_contacts.iter().filter(|_| any) {
+        for &ci in &self.touching_contacts {
             let pair = if solved.next_if_eq(&&ci).is_some() {
                 self.colour_keys.get(ci as usize).map(|k| k.slots())
             } else {
