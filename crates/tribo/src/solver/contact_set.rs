@@ -41,7 +41,7 @@ use super::contact_wide::{self, StoredContact, WideCold, WideContact, WideHead, 
 use super::wide::LANES;
 use super::{
     any_load, for_each_chunk_mut3, integrate_position_one, integrate_velocity_one, BodySim, ConstraintSet, SharedState,
-    SpinBarrier, StateCell, StateRead, StepContext,
+    StateCell, StateRead, StepContext, TeamProgress,
 };
 use crate::collision::contact::{Contact, NO_COLOUR};
 use crate::math::Vec2;
@@ -261,26 +261,50 @@ const MIN_CARRY_COSINE: f32 = 0.7;
 /// large_pyramid and many_pyramids) while 96 gained nothing more.
 const TEAM_BLOCK: usize = 48;
 
-/// A block of one colour's groups for the substep team: claimed by one thread per pass
-/// (`claimed` holds the number of the last pass that took it); the mutex only hands the
-/// claiming thread its `&mut` (never contended). One per cache line: a claim writes no
-/// line another thread's blocks share.
+/// Bodies per block of the substep team's integration passes: ~2 µs of work, so a late
+/// thread's share is taken over in small pieces.
+const TEAM_BODY_BLOCK: usize = 256;
+
+/// A block of the substep team's work: claimed by one thread per pass. `claimed` holds
+/// the number of the last pass that took it, and a thread takes it for pass `p` only if
+/// that number is below `p` (`fetch_max`), so a thread late by several passes never takes
+/// a block again that another has already taken for a later pass. One per cache line: a
+/// claim writes no line another thread's blocks share.
 #[repr(align(64))]
-struct TeamBlock<'a> {
+struct TeamBlock<T> {
     claimed: core::sync::atomic::AtomicU32,
-    part: std::sync::Mutex<(&'a mut [WideHead], &'a mut [WideContact])>,
+    work: T,
 }
 
-/// One part of a colour for the substep team: its blocks, thread `k`'s own ones being
+impl<T> TeamBlock<T> {
+    fn new(work: T) -> TeamBlock<T> {
+        TeamBlock {
+            claimed: core::sync::atomic::AtomicU32::new(0),
+            work,
+        }
+    }
+
+    /// Takes the block for pass `stamp`; false if some thread already has.
+    #[inline]
+    fn claim(&self, stamp: u32) -> bool {
+        self.claimed.fetch_max(stamp, core::sync::atomic::Ordering::AcqRel) < stamp
+    }
+}
+
+/// A colour's block: its groups (the mutex only hands the claiming thread its `&mut`; it
+/// is never contended).
+type GroupBlock<'a> = TeamBlock<std::sync::Mutex<(&'a mut [WideHead], &'a mut [WideContact])>>;
+
+/// One part of a pass for the substep team: its blocks, thread `k`'s own ones being
 /// `blocks[shares[k] .. shares[k + 1]]` (see `ContactSolver::team_blocks`).
-struct TeamPart<'a> {
-    blocks: Vec<TeamBlock<'a>>,
+struct TeamPart<B> {
+    blocks: Vec<B>,
     shares: Vec<usize>,
 }
 
-impl<'a> TeamPart<'a> {
+impl<B> TeamPart<B> {
     /// Thread `k`'s own blocks.
-    fn own(&self, k: usize) -> &[TeamBlock<'a>] {
+    fn own(&self, k: usize) -> &[B] {
         let (a, b) = (
             self.shares.get(k).copied().unwrap_or(0),
             self.shares.get(k + 1).copied().unwrap_or(0),
@@ -289,7 +313,7 @@ impl<'a> TeamPart<'a> {
     }
 
     /// The blocks before and after thread `k`'s own.
-    fn others(&self, k: usize) -> (&[TeamBlock<'a>], &[TeamBlock<'a>]) {
+    fn others(&self, k: usize) -> (&[B], &[B]) {
         let (a, b) = (
             self.shares.get(k).copied().unwrap_or(0),
             self.shares.get(k + 1).copied().unwrap_or(0),
@@ -297,6 +321,70 @@ impl<'a> TeamPart<'a> {
         let (before, rest) = self.blocks.split_at(a.min(self.blocks.len()));
         (before, rest.get(b.saturating_sub(a)..).unwrap_or(&[]))
     }
+}
+
+/// The substep team's integration blocks: bodies `1..n` (0 is the static body), thread
+/// `k`'s share being its range `k·per_thread ..` (the bodies its colour shares touch
+/// most, see `ContactSolver::team_blocks`), cut into [`TEAM_BODY_BLOCK`]s.
+fn team_body_blocks(n: usize, threads: usize, per_thread: usize) -> TeamPart<TeamBlock<core::ops::Range<usize>>> {
+    let mut part = TeamPart {
+        blocks: Vec::new(),
+        shares: Vec::with_capacity(threads + 1),
+    };
+    for k in 0..threads {
+        part.shares.push(part.blocks.len());
+        let (start, end) = ((k * per_thread).max(1), ((k + 1) * per_thread).min(n));
+        let mut at = start;
+        while at < end {
+            let next = (at + TEAM_BODY_BLOCK).min(end);
+            part.blocks.push(TeamBlock::new(at..next));
+            at = next;
+        }
+    }
+    part.shares.push(part.blocks.len());
+    part
+}
+
+/// Runs thread `k`'s part of one team pass over `parts` (pass number `stamp`) and waits
+/// until the whole pass is done: its own share whole, then the others' shares from their
+/// far ends back to the first block already taken, as Box2D v3's solver stages steal (the
+/// owner works towards it, so the blocks beyond are taken too, or soon will be; trying
+/// every block would cost a cache-line transfer per block, the owner's claim). `target`:
+/// the running total of blocks to be done by the end of this pass. A thread that comes
+/// after the pass is done skips it.
+fn team_pass<T>(
+    parts: &[TeamPart<TeamBlock<T>>],
+    k: usize,
+    stamp: u32,
+    progress: &TeamProgress,
+    target: &mut u64,
+    f: impl Fn(&T),
+) {
+    *target += parts.iter().map(|p| p.blocks.len() as u64).sum::<u64>();
+    if progress.reached(*target) {
+        return;
+    }
+    let mut done = 0u64;
+    let mut run = |block: &TeamBlock<T>| {
+        let mine = block.claim(stamp);
+        if mine {
+            f(&block.work);
+            done += 1;
+        }
+        mine
+    };
+    for part in parts {
+        part.own(k).iter().for_each(|b| {
+            run(b);
+        });
+    }
+    for part in parts {
+        let (before, after) = part.others(k);
+        let _ = after.iter().rev().all(&mut run);
+        let _ = before.iter().rev().all(&mut run);
+    }
+    progress.finish(done);
+    progress.wait_for(*target);
 }
 
 /// Wide constraints per parallel chunk of a colour.
@@ -985,13 +1073,14 @@ impl ConstraintSet for ContactSolver {
 }
 
 impl ContactSolver {
-    /// The worker-team substep loop (see [`ConstraintSet::substeps_team`]): one job on
-    /// every thread of the pool for all substeps; each thread integrates its range of
-    /// bodies and solves blocks of every colour (its own share first, then blocks the
-    /// others have not started, as Box2D v3's solver stages steal blocks), with a spin
-    /// barrier after each colour and stage. Each block is solved exactly once per pass and
-    /// a colour's constraints share no moving body, so the result does not depend on the
-    /// thread count or on who solved which block. Only for steps without overflow
+    /// The worker-team substep loop (see [`ConstraintSet::substeps_team`]): one job per
+    /// thread of the pool for all substeps; each integrates blocks of bodies and solves
+    /// blocks of every colour (its own share first, then blocks the others have not
+    /// started, as Box2D v3's solver stages steal blocks), and after each colour and stage
+    /// waits until all of that pass's blocks are done ([`team_pass`]). Each block is solved
+    /// exactly once per pass, a colour's constraints share no moving body and each body is
+    /// integrated by itself, so the result does not depend on the thread count or on who
+    /// solved which block. Only for steps without overflow
     /// constraints and mass-ratio groups (scalar work the team would have to serialise);
     /// those run the per-colour path.
     fn team_loop(&mut self, ctx: &StepContext, sims: &[BodySim], states: &[SharedState], times: &mut [f32; 5]) -> bool {
@@ -1002,69 +1091,51 @@ impl ContactSolver {
         let soft = self.soft;
         let bodies_per_thread = sims.len().div_ceil(threads).max(1);
         let colours = self.team_blocks(threads, bodies_per_thread);
-        let barrier = SpinBarrier::new(threads);
+        let bodies = [team_body_blocks(sims.len(), threads, bodies_per_thread)];
+        let progress = TeamProgress::new();
         let times_out = std::sync::Mutex::new([0.0f32; 5]);
-        // `pass` counts the colour passes; every thread runs the same sequence of them, so
-        // their counters agree, and a block is claimed for a pass by stamping its number.
-        let each_colour = |k: usize, pass: &mut u32, f: &dyn Fn(&mut WideHead, &mut WideContact)| {
-            for parts in &colours {
-                *pass += 1;
-                let stamp = *pass;
-                // Whether this thread claimed the block (and solved it).
-                let run = |block: &TeamBlock<'_>| {
-                    let mine = block.claimed.swap(stamp, core::sync::atomic::Ordering::AcqRel) != stamp;
-                    if mine {
-                        let mut guard = block.part.lock().unwrap_or_else(|e| e.into_inner());
+        // Every closure runs the same sequence of passes, numbered by `pass` (a block is
+        // claimed for a pass by stamping its number) and ending at the running totals
+        // `target` of blocks, so their counters agree.
+        let work = |k: usize| {
+            let mut lap = Stopwatch::start();
+            let mut t = [0.0f32; 5];
+            let (mut pass, mut target) = (0u32, 0u64);
+            let each_colour = |pass: &mut u32, target: &mut u64, f: &dyn Fn(&mut WideHead, &mut WideContact)| {
+                for parts in &colours {
+                    *pass += 1;
+                    team_pass(parts, k, *pass, &progress, target, |part| {
+                        let mut guard = part.lock().unwrap_or_else(|e| e.into_inner());
                         let (heads, wides) = &mut *guard;
                         for (h, w) in heads.iter_mut().zip(wides.iter_mut()) {
                             f(h, w);
                         }
-                    }
-                    mine
-                };
-                // Its own share whole (every block is then solved by someone); the others'
-                // only up to the first block already taken, as Box2D v3's stages steal: the
-                // owner works towards it, so the blocks beyond are taken too, or soon will be.
-                // Trying every block costs a cache-line transfer per block (the owner's claim
-                // stamp), twice per pass.
-                for part in parts {
-                    part.own(k).iter().for_each(|b| {
-                        run(b);
                     });
                 }
-                for part in parts {
-                    let (before, after) = part.others(k);
-                    let _ = after.iter().rev().all(run);
-                    let _ = before.iter().rev().all(run);
-                }
-                barrier.wait();
-            }
-        };
-        rayon::broadcast(|bc| {
-            let k = bc.index();
-            let bodies = (k * bodies_per_thread).max(1)..((k + 1) * bodies_per_thread).min(sims.len());
-            let mut lap = Stopwatch::start();
-            let mut t = [0.0f32; 5];
-            let mut pass = 0u32;
+            };
             for i in 0..ctx.substeps {
                 let elapsed = i as f32 * ctx.h;
-                for b in bodies.clone() {
-                    integrate_velocity_one(ctx.h, &sims[b], &states[b]);
-                }
-                barrier.wait();
+                pass += 1;
+                team_pass(&bodies, k, pass, &progress, &mut target, |range| {
+                    for b in range.clone() {
+                        integrate_velocity_one(ctx.h, &sims[b], &states[b]);
+                    }
+                });
                 t[0] += lap.lap();
-                each_colour(k, &mut pass, &|h, _| contact_wide::warm_start(h, states));
+                each_colour(&mut pass, &mut target, &|h, _| contact_wide::warm_start(h, states));
                 t[1] += lap.lap();
-                each_colour(k, &mut pass, &|h, w| {
+                each_colour(&mut pass, &mut target, &|h, w| {
                     contact_wide::solve::<true, SharedState>(h, w, states, ctx, &soft, elapsed)
                 });
                 t[2] += lap.lap();
-                for b in bodies.clone() {
-                    integrate_position_one(ctx, &sims[b], &states[b]);
-                }
-                barrier.wait();
+                pass += 1;
+                team_pass(&bodies, k, pass, &progress, &mut target, |range| {
+                    for b in range.clone() {
+                        integrate_position_one(ctx, &sims[b], &states[b]);
+                    }
+                });
                 t[3] += lap.lap();
-                each_colour(k, &mut pass, &|h, w| {
+                each_colour(&mut pass, &mut target, &|h, w| {
                     contact_wide::solve::<false, SharedState>(h, w, states, ctx, &soft, elapsed + ctx.h)
                 });
                 t[4] += lap.lap();
@@ -1072,6 +1143,17 @@ impl ContactSolver {
             if k == 0 {
                 *times_out.lock().unwrap_or_else(|e| e.into_inner()) = t;
             }
+        };
+        // Thread 0's work on this thread, the others' spawned: a spawned share that no
+        // other thread has started when this one is done runs here, and finds every pass
+        // done (rayon's scope runs its own pending jobs while it waits), so the step never
+        // waits for a thread that is not running.
+        rayon::scope(|s| {
+            for k in 1..threads {
+                let work = &work;
+                s.spawn(move |_| work(k));
+            }
+            work(0);
         });
         *times = times_out.into_inner().unwrap_or_else(|e| e.into_inner());
         true
@@ -1088,7 +1170,7 @@ impl ContactSolver {
     /// ended at different bodies, and about 15 000 cache lines of states crossed between the
     /// two cores per large_pyramid step. Where a part is not in body order the cuts are only
     /// worse, never wrong: every block is still solved once per pass.
-    fn team_blocks(&mut self, threads: usize, per_thread: usize) -> Vec<Vec<TeamPart<'_>>> {
+    fn team_blocks(&mut self, threads: usize, per_thread: usize) -> Vec<Vec<TeamPart<GroupBlock<'_>>>> {
         // Group boundaries, in order: per colour, per part, per thread.
         let owner_key = |h: &WideHead| {
             let (a, b) = (h.index_a[0], h.index_b[0]);
@@ -1132,10 +1214,7 @@ impl ContactSolver {
                     let (w, w_rest) = core::mem::take(&mut wides).split_at_mut(len);
                     (heads, wides, taken) = (h_rest, w_rest, at[k + 1]);
                     for part_of in h.chunks_mut(TEAM_BLOCK).zip(w.chunks_mut(TEAM_BLOCK)) {
-                        part.blocks.push(TeamBlock {
-                            claimed: core::sync::atomic::AtomicU32::new(0),
-                            part: std::sync::Mutex::new(part_of),
-                        });
+                        part.blocks.push(TeamBlock::new(std::sync::Mutex::new(part_of)));
                     }
                 }
                 part.shares.push(part.blocks.len());
@@ -1155,5 +1234,77 @@ impl ContactSolver {
             }
             Slot::Overflow(i) => *cc = self.overflow[i as usize],
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::sync::atomic::{AtomicBool, AtomicU32, Ordering::Relaxed};
+
+    /// Two threads' shares of `n` blocks, each block counting the passes that ran it.
+    fn counting_part(n: usize) -> TeamPart<TeamBlock<AtomicU32>> {
+        TeamPart {
+            blocks: (0..n).map(|_| TeamBlock::new(AtomicU32::new(0))).collect(),
+            shares: vec![0, n / 2, n],
+        }
+    }
+
+    /// Runs `passes` passes as thread `k`: each block checks that every block ran the pass
+    /// before (the pass order a team relies on) and counts itself.
+    fn run_passes(
+        part: &TeamPart<TeamBlock<AtomicU32>>,
+        k: usize,
+        passes: u32,
+        progress: &TeamProgress,
+        ok: &AtomicBool,
+    ) {
+        let parts = core::slice::from_ref(part);
+        let mut target = 0;
+        for pass in 1..=passes {
+            team_pass(parts, k, pass, progress, &mut target, |count| {
+                if part.blocks.iter().any(|b| b.work.load(Relaxed) + 1 < pass) || count.load(Relaxed) != pass - 1 {
+                    ok.store(false, Relaxed);
+                }
+                // A few microseconds of work, so the two threads' passes overlap.
+                let mut x = 1.0f32;
+                for _ in 0..2000 {
+                    x = core::hint::black_box(x * 1.000_1);
+                }
+                count.fetch_add(1, Relaxed);
+            });
+        }
+    }
+
+    /// A thread of a two-thread team that never comes does not hold up the other: it runs
+    /// every block once per pass by itself (a barrier that waits for every thread would
+    /// never return), and the late thread, when it comes, finds every pass done.
+    #[test]
+    fn team_passes_finish_without_the_other_thread() {
+        let (part, progress, ok) = (counting_part(7), TeamProgress::new(), AtomicBool::new(true));
+        run_passes(&part, 0, 5, &progress, &ok);
+        assert!(part.blocks.iter().all(|b| b.work.load(Relaxed) == 5));
+        run_passes(&part, 1, 5, &progress, &ok);
+        assert!(
+            part.blocks.iter().all(|b| b.work.load(Relaxed) == 5),
+            "a late thread ran a pass again"
+        );
+        assert!(ok.load(Relaxed) && progress.reached(35));
+    }
+
+    /// Two threads, one starting late: every block runs exactly once per pass, and no
+    /// block of a pass runs before every block of the pass before it.
+    #[test]
+    fn team_passes_run_each_block_once_in_pass_order() {
+        let (part, progress, ok) = (counting_part(16), TeamProgress::new(), AtomicBool::new(true));
+        std::thread::scope(|s| {
+            s.spawn(|| run_passes(&part, 0, 200, &progress, &ok));
+            s.spawn(|| {
+                std::thread::sleep(std::time::Duration::from_millis(1));
+                run_passes(&part, 1, 200, &progress, &ok)
+            });
+        });
+        assert!(ok.load(Relaxed), "a block ran out of pass order or twice in a pass");
+        assert!(part.blocks.iter().all(|b| b.work.load(Relaxed) == 200));
     }
 }
