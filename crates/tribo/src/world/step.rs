@@ -624,7 +624,7 @@ impl World {
                 linear_damping: if dynamic { b.linear_damping } else { 0.0 },
                 angular_damping: if dynamic { b.angular_damping } else { 0.0 },
                 body: bi,
-                shape: b.shapes.first().map_or(u32::MAX, |id| id.index),
+                shape: b.first_shape,
                 jointed: !b.joints.is_empty(),
             });
         }
