@@ -56,7 +56,7 @@ impl World {
         self.reorder_contacts();
         self.update_pairs();
         self.profile.pairs = lap.lap();
-        self.prepare_bodies();
+        self.prepare_bodies(parallel);
         let bodies_ms = lap.lap();
         self.collide(dt, parallel);
         self.profile.collide = lap.lap();
@@ -496,7 +496,7 @@ impl World {
             // The woken islands' bodies get solver entries (every awake body's index can
             // change) and their contacts join the solve with their last manifolds: the
             // entries and every touching contact's candidate are made again.
-            self.prepare_bodies();
+            self.prepare_bodies(parallel);
             let flags = core::mem::take(&mut self.scratch_flags);
             self.collect_active_contacts(&mut touching, &flags, self.mostly_awake, true);
             self.scratch_flags = flags;
@@ -558,7 +558,7 @@ impl World {
     /// The awake bodies' solver states and step data, and one [`SolverBody`] per body slot
     /// (index 0 of the states: every static body). Made before the narrow phase, which
     /// makes the solver's candidates from them.
-    fn prepare_bodies(&mut self) {
+    fn prepare_bodies(&mut self, parallel: bool) {
         let g = self.def.gravity;
         self.states.clear();
         self.sims.clear();
@@ -571,66 +571,79 @@ impl World {
         self.solver_bodies.truncate(capacity);
         self.scratch_flags.resize(capacity, false);
         self.scratch_flags.truncate(capacity);
-        for bi in 0..capacity as u32 {
-            let Some(sb) = self.solver_bodies.get_mut(bi as usize) else {
-                continue;
-            };
-            if let Some(f) = self.scratch_flags.get_mut(bi as usize) {
-                *f = false;
+        if parallel && capacity > BODY_CHUNK {
+            self.prepare_bodies_parallel(g);
+        } else {
+            for (bi, (sb, flag)) in self
+                .solver_bodies
+                .iter_mut()
+                .zip(self.scratch_flags.iter_mut())
+                .enumerate()
+            {
+                let b = self.bodies.at(bi as u32);
+                *flag = b.is_some_and(solved);
+                *sb = solver_body(b, self.states.len() as u32);
+                if let Some(b) = b.filter(|b| solved(b)) {
+                    self.states.push(body_state(b));
+                    self.sims.push(body_sim(b, bi as u32, g));
+                }
             }
-            let Some(b) = self.bodies.at(bi) else {
-                *sb = SolverBody::default();
-                continue;
-            };
-            *sb = SolverBody {
-                index: 0,
-                awake_dynamic: false,
-                inv_mass: 0.0,
-                inv_i: 0.0,
-                center: b.center,
-                xf: b.xf,
-                v: b.v,
-                w: b.w,
-                max_extent: b.max_extent,
-                reach: b.max_extent + b.local_center.length(),
-            };
-            if !b.awake || b.body_type == BodyType::Static {
-                continue;
-            }
-            if let Some(f) = self.scratch_flags.get_mut(bi as usize) {
-                *f = true;
-            }
-            sb.index = self.states.len() as u32;
-            sb.awake_dynamic = b.is_dynamic();
-            sb.inv_mass = b.inv_mass;
-            sb.inv_i = b.inv_inertia;
-            self.states.push(BodyState {
-                v: b.v,
-                w: b.w,
-                touched: 0.0,
-                dp: Vec2::ZERO,
-                dq: Rot::IDENTITY,
-            });
-            let dynamic = b.body_type == BodyType::Dynamic;
-            let force = b.force + b.constant_force;
-            let torque = b.torque + b.constant_torque;
-            self.sims.push(BodySim {
-                linear_accel: if dynamic {
-                    b.inv_mass * force + b.gravity_scale * g
-                } else {
-                    Vec2::ZERO
-                },
-                angular_accel: if dynamic { b.inv_inertia * torque } else { 0.0 },
-                linear_damping: if dynamic { b.linear_damping } else { 0.0 },
-                angular_damping: if dynamic { b.angular_damping } else { 0.0 },
-                body: bi,
-                shape: b.first_shape,
-                jointed: !b.joints.is_empty(),
-            });
         }
         // Bodies whose contacts the narrow phase visits (awake and not static): most of
         // them, or few (see `World::collide`).
         self.mostly_awake = 2 * (self.states.len() - 1) > self.bodies.len();
+    }
+
+    /// [`World::prepare_bodies`] on the pool's threads, with the same result: the solved
+    /// bodies of each chunk of [`BODY_CHUNK`] slots are counted first, so each chunk knows
+    /// where its states start (solver order stays slot order); then every chunk writes its
+    /// entries, states and step data. Done serially this pass was a tenth of
+    /// large_pyramid's two-thread set-up.
+    fn prepare_bodies_parallel(&mut self, g: Vec2) {
+        use rayon::prelude::*;
+        let bodies = &self.bodies;
+        let capacity = self.solver_bodies.len();
+        let counts: Vec<usize> = (0..capacity.div_ceil(BODY_CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                (c * BODY_CHUNK..((c + 1) * BODY_CHUNK).min(capacity))
+                    .filter(|&bi| bodies.at(bi as u32).is_some_and(solved))
+                    .count()
+            })
+            .collect();
+        let total: usize = counts.iter().sum();
+        self.states.resize(total + 1, BodyState::default());
+        self.sims.resize(total + 1, BodySim::default());
+        // Each chunk's share of the states and step data, and its first solver index.
+        let mut shares = Vec::with_capacity(counts.len());
+        let (mut states, mut sims, mut first) = (&mut self.states[1..], &mut self.sims[1..], 1usize);
+        for &n in &counts {
+            let (st, st_rest) = core::mem::take(&mut states).split_at_mut(n);
+            let (si, si_rest) = core::mem::take(&mut sims).split_at_mut(n);
+            shares.push((first, st, si));
+            (states, sims, first) = (st_rest, si_rest, first + n);
+        }
+        self.solver_bodies
+            .par_chunks_mut(BODY_CHUNK)
+            .zip(self.scratch_flags.par_chunks_mut(BODY_CHUNK))
+            .zip(shares)
+            .enumerate()
+            .for_each(|(c, ((entries, flags), (first, states, sims)))| {
+                let mut next = 0usize;
+                for (k, (sb, flag)) in entries.iter_mut().zip(flags.iter_mut()).enumerate() {
+                    let bi = c * BODY_CHUNK + k;
+                    let b = bodies.at(bi as u32);
+                    *flag = b.is_some_and(solved);
+                    *sb = solver_body(b, (first + next) as u32);
+                    if let Some(b) = b.filter(|b| solved(b)) {
+                        if let (Some(state), Some(sim)) = (states.get_mut(next), sims.get_mut(next)) {
+                            *state = body_state(b);
+                            *sim = body_sim(b, bi as u32, g);
+                        }
+                        next += 1;
+                    }
+                }
+            });
     }
 
     /// Builds the solver's constraints from the candidates the narrow phase made, runs the
@@ -918,8 +931,69 @@ impl World {
     }
 }
 
-/// Bodies per parallel chunk of finalize.
+/// Bodies per parallel chunk of finalize and of the step's body pass.
 const BODY_CHUNK: usize = 256;
+
+/// Whether the solver gets a state for body `b`: awake and not static.
+#[inline]
+fn solved(b: &Body) -> bool {
+    b.awake && b.body_type != BodyType::Static
+}
+
+/// Body `b`'s solver entry (`b`: the slot's body, if any); `index`: its solver index, if
+/// it is [`solved`].
+#[inline]
+fn solver_body(b: Option<&Body>, index: u32) -> SolverBody {
+    let Some(b) = b else {
+        return SolverBody::default();
+    };
+    let on = solved(b);
+    SolverBody {
+        index: if on { index } else { 0 },
+        awake_dynamic: on && b.is_dynamic(),
+        inv_mass: if on { b.inv_mass } else { 0.0 },
+        inv_i: if on { b.inv_inertia } else { 0.0 },
+        center: b.center,
+        xf: b.xf,
+        v: b.v,
+        w: b.w,
+        max_extent: b.max_extent,
+        reach: b.max_extent + b.local_center.length(),
+    }
+}
+
+/// A solved body's state at the start of the step.
+#[inline]
+fn body_state(b: &Body) -> BodyState {
+    BodyState {
+        v: b.v,
+        w: b.w,
+        touched: 0.0,
+        dp: Vec2::ZERO,
+        dq: Rot::IDENTITY,
+    }
+}
+
+/// A solved body's step data (slot `bi`; `g`: the world's gravity [m/s²]).
+#[inline]
+fn body_sim(b: &Body, bi: u32, g: Vec2) -> BodySim {
+    let dynamic = b.body_type == BodyType::Dynamic;
+    let force = b.force + b.constant_force;
+    let torque = b.torque + b.constant_torque;
+    BodySim {
+        linear_accel: if dynamic {
+            b.inv_mass * force + b.gravity_scale * g
+        } else {
+            Vec2::ZERO
+        },
+        angular_accel: if dynamic { b.inv_inertia * torque } else { 0.0 },
+        linear_damping: if dynamic { b.linear_damping } else { 0.0 },
+        angular_damping: if dynamic { b.angular_damping } else { 0.0 },
+        body: bi,
+        shape: b.first_shape,
+        jointed: !b.joints.is_empty(),
+    }
+}
 
 /// Contacts per parallel chunk of the narrow phase and the impulse store.
 const CONTACT_CHUNK: usize = 256;
