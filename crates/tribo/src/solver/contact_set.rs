@@ -33,7 +33,7 @@
 //! [`team_loop`]: ContactSolver::team_loop
 
 use super::contact_solver::{
-    bounces, build_constraint, end_substep_one, estimate, is_new_resting, record_approach, restitution_one, solve_one,
+    build_constraint, end_substep_one, estimate, is_new_resting, record_approach, restitution_one, solve_one,
     store_impulses, warm_start_one, ConstraintBodies, ContactConstraint, ContactInput, StepSoftness, MASS_RATIO_GROUP,
     MAX_ESTIMATE_SWEEPS, MAX_LOCAL_SWEEPS, ONGOING_ESTIMATE_SWEEPS,
 };
@@ -1045,28 +1045,11 @@ impl ConstraintSet for ContactSolver {
         if !self.any_restitution {
             return;
         }
-        for g in 0..self.wide.len() {
-            if !self.cold[g].any_restitution {
-                continue;
-            }
-            for l in 0..LANES {
-                // Only lanes with a point that bounces (restitution_one's own test, read
-                // from the lanes: unpacking a lane costs more than its restitution row).
-                let (cold, w) = (&self.cold[g], &self.wide[g]);
-                let count = (cold.count[l] as usize).min(2);
-                let any = w.points[..count].iter().any(|p| {
-                    bounces(
-                        cold.restitution[l],
-                        cold.restitution_threshold[l],
-                        p.approach.0[l],
-                        p.max_normal_impulse.0[l],
-                    )
-                });
-                if any {
-                    let mut cc = contact_wide::unpack_full(&self.head[g], &self.wide[g], &self.cold[g], &self.soft, l);
-                    restitution_one(&mut cc, states);
-                    contact_wide::pack_state(&mut self.head[g], &mut self.wide[g], l, &cc);
-                }
+        // Four lanes at once; a group's lanes share no moving body (one colour), and the
+        // groups run in order, as the scalar loop ran.
+        for ((h, w), cold) in self.head.iter_mut().zip(self.wide.iter_mut()).zip(&self.cold) {
+            if cold.any_restitution {
+                contact_wide::restitution(h, w, cold, states);
             }
         }
     }
