@@ -170,9 +170,9 @@ pub(crate) struct Body {
     /// Largest distance from the centre of mass to any of its shapes' points [m].
     pub max_extent: f32,
     pub shapes: Vec<ShapeId>,
-    /// Slot index of `shapes[0]` (`u32::MAX`: none), kept with the list (`World::create_shape`,
-    /// `World::destroy_shape`): the step's pass over the bodies reads it without following
-    /// the list's pointer (a dependent cache miss per body: 20 % of that pass).
+    /// Slot index of `shapes[0]` (`u32::MAX`: none), kept with the list
+    /// ([`Body::shapes_changed`]): the step's pass over the bodies reads it without
+    /// following the list's pointer (a dependent cache miss per body: 20 % of that pass).
     pub first_shape: u32,
     /// Indices of the contacts this body takes part in.
     pub contacts: Vec<u32>,
@@ -187,6 +187,11 @@ pub(crate) struct Body {
 }
 
 impl Body {
+    /// Call after `shapes` changed: keeps `first_shape` with the list.
+    pub(crate) fn shapes_changed(&mut self) {
+        self.first_shape = self.shapes.first().map_or(u32::MAX, |s| s.index);
+    }
+
     pub(crate) fn new(def: &BodyDef) -> Body {
         let xf = Transform::new(def.position, def.angle);
         let moving = def.body_type != BodyType::Static;

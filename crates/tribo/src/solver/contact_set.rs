@@ -345,25 +345,34 @@ fn team_body_blocks(n: usize, threads: usize, per_thread: usize) -> TeamPart<Tea
     part
 }
 
-/// Runs thread `k`'s part of one team pass over `parts` (pass number `stamp`) and waits
-/// until the whole pass is done: its own share whole, then the others' shares from their
-/// far ends back to the first block already taken, as Box2D v3's solver stages steal (the
-/// owner works towards it, so the blocks beyond are taken too, or soon will be; trying
-/// every block would cost a cache-line transfer per block, the owner's claim). `target`:
-/// the running total of blocks to be done by the end of this pass. A thread that comes
+/// Where one thread of the team is in the job's sequence of passes: the number of the
+/// pass (a block is claimed for a pass by stamping it) and the running total of blocks
+/// done by its end. Every thread runs the same sequence, so their cursors agree.
+#[derive(Default)]
+struct TeamCursor {
+    pass: u32,
+    target: u64,
+}
+
+/// Runs thread `k`'s part of the next team pass over `parts` and waits until the whole
+/// pass is done: its own share whole, then the others' shares from their far ends back to
+/// the first block already taken, as Box2D v3's solver stages steal (the owner works
+/// towards it, so the blocks beyond are taken too, or soon will be; trying every block
+/// would cost a cache-line transfer per block, the owner's claim). A thread that comes
 /// after the pass is done skips it.
 fn team_pass<T>(
     parts: &[TeamPart<TeamBlock<T>>],
     k: usize,
-    stamp: u32,
+    at: &mut TeamCursor,
     progress: &TeamProgress,
-    target: &mut u64,
     f: impl Fn(&T),
 ) {
-    *target += parts.iter().map(|p| p.blocks.len() as u64).sum::<u64>();
-    if progress.reached(*target) {
+    at.pass += 1;
+    at.target += parts.iter().map(|p| p.blocks.len() as u64).sum::<u64>();
+    if progress.reached(at.target) {
         return;
     }
+    let stamp = at.pass;
     let mut done = 0u64;
     let mut run = |block: &TeamBlock<T>| {
         let mine = block.claim(stamp);
@@ -384,7 +393,7 @@ fn team_pass<T>(
         let _ = before.iter().rev().all(&mut run);
     }
     progress.finish(done);
-    progress.wait_for(*target);
+    progress.wait_for(at.target);
 }
 
 /// Wide constraints per parallel chunk of a colour.
@@ -1063,9 +1072,9 @@ impl ContactSolver {
     /// waits until all of that pass's blocks are done ([`team_pass`]). Each block is solved
     /// exactly once per pass, a colour's constraints share no moving body and each body is
     /// integrated by itself, so the result does not depend on the thread count or on who
-    /// solved which block. Only for steps without overflow
-    /// constraints and mass-ratio groups (scalar work the team would have to serialise);
-    /// those run the per-colour path.
+    /// solved which block. Only for steps without overflow constraints and mass-ratio
+    /// groups (scalar work the team would have to serialise); those run the per-colour
+    /// path.
     fn team_loop(&mut self, ctx: &StepContext, sims: &[BodySim], states: &[SharedState], times: &mut [f32; 5]) -> bool {
         let threads = rayon::current_num_threads();
         if threads < 2 || !self.overflow.is_empty() || !self.groups.is_empty() || self.wide.is_empty() {
@@ -1077,17 +1086,13 @@ impl ContactSolver {
         let bodies = [team_body_blocks(sims.len(), threads, bodies_per_thread)];
         let progress = TeamProgress::new();
         let times_out = std::sync::Mutex::new([0.0f32; 5]);
-        // Every closure runs the same sequence of passes, numbered by `pass` (a block is
-        // claimed for a pass by stamping its number) and ending at the running totals
-        // `target` of blocks, so their counters agree.
         let work = |k: usize| {
             let mut lap = Stopwatch::start();
             let mut t = [0.0f32; 5];
-            let (mut pass, mut target) = (0u32, 0u64);
-            let each_colour = |pass: &mut u32, target: &mut u64, f: &dyn Fn(&mut WideHead, &mut WideContact)| {
+            let mut at = TeamCursor::default();
+            let each_colour = |at: &mut TeamCursor, f: &dyn Fn(&mut WideHead, &mut WideContact)| {
                 for parts in &colours {
-                    *pass += 1;
-                    team_pass(parts, k, *pass, &progress, target, |part| {
+                    team_pass(parts, k, at, &progress, |part| {
                         let mut guard = part.lock().unwrap_or_else(|e| e.into_inner());
                         let (heads, wides) = &mut *guard;
                         for (h, w) in heads.iter_mut().zip(wides.iter_mut()) {
@@ -1098,27 +1103,25 @@ impl ContactSolver {
             };
             for i in 0..ctx.substeps {
                 let elapsed = i as f32 * ctx.h;
-                pass += 1;
-                team_pass(&bodies, k, pass, &progress, &mut target, |range| {
+                team_pass(&bodies, k, &mut at, &progress, |range| {
                     for b in range.clone() {
                         integrate_velocity_one(ctx.h, &sims[b], &states[b]);
                     }
                 });
                 t[0] += lap.lap();
-                each_colour(&mut pass, &mut target, &|h, _| contact_wide::warm_start(h, states));
+                each_colour(&mut at, &|h, _| contact_wide::warm_start(h, states));
                 t[1] += lap.lap();
-                each_colour(&mut pass, &mut target, &|h, w| {
+                each_colour(&mut at, &|h, w| {
                     contact_wide::solve::<true, SharedState>(h, w, states, ctx, &soft, elapsed)
                 });
                 t[2] += lap.lap();
-                pass += 1;
-                team_pass(&bodies, k, pass, &progress, &mut target, |range| {
+                team_pass(&bodies, k, &mut at, &progress, |range| {
                     for b in range.clone() {
                         integrate_position_one(ctx, &sims[b], &states[b]);
                     }
                 });
                 t[3] += lap.lap();
-                each_colour(&mut pass, &mut target, &|h, w| {
+                each_colour(&mut at, &|h, w| {
                     contact_wide::solve::<false, SharedState>(h, w, states, ctx, &soft, elapsed + ctx.h)
                 });
                 t[4] += lap.lap();
@@ -1243,9 +1246,9 @@ mod tests {
         ok: &AtomicBool,
     ) {
         let parts = core::slice::from_ref(part);
-        let mut target = 0;
+        let mut at = TeamCursor::default();
         for pass in 1..=passes {
-            team_pass(parts, k, pass, progress, &mut target, |count| {
+            team_pass(parts, k, &mut at, progress, |count| {
                 if part.blocks.iter().any(|b| b.work.load(Relaxed) + 1 < pass) || count.load(Relaxed) != pass - 1 {
                     ok.store(false, Relaxed);
                 }

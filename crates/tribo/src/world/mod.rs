@@ -692,7 +692,7 @@ impl World {
         self.sync_shape_bounds(index);
         if let Some(b) = self.bodies.at_mut(body.index) {
             b.shapes.push(id);
-            b.first_shape = b.shapes.first().map_or(u32::MAX, |s| s.index);
+            b.shapes_changed();
         }
         self.update_mass(body.index);
         self.wake_body(body.index);
@@ -706,7 +706,7 @@ impl World {
         self.remove_shape_internal(id);
         if let Some(b) = self.bodies.at_mut(body.index) {
             b.shapes.retain(|s| *s != id);
-            b.first_shape = b.shapes.first().map_or(u32::MAX, |s| s.index);
+            b.shapes_changed();
         }
         self.update_mass(body.index);
         Ok(())

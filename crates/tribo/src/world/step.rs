@@ -580,10 +580,7 @@ impl World {
                 .zip(self.scratch_flags.iter_mut())
                 .enumerate()
             {
-                let b = self.bodies.at(bi as u32);
-                *flag = b.is_some_and(solved);
-                *sb = solver_body(b, self.states.len() as u32);
-                if let Some(b) = b.filter(|b| solved(b)) {
+                if let Some(b) = prepare_slot(self.bodies.at(bi as u32), self.states.len() as u32, sb, flag) {
                     self.states.push(body_state(b));
                     self.sims.push(body_sim(b, bi as u32, g));
                 }
@@ -632,10 +629,7 @@ impl World {
                 let mut next = 0usize;
                 for (k, (sb, flag)) in entries.iter_mut().zip(flags.iter_mut()).enumerate() {
                     let bi = c * BODY_CHUNK + k;
-                    let b = bodies.at(bi as u32);
-                    *flag = b.is_some_and(solved);
-                    *sb = solver_body(b, (first + next) as u32);
-                    if let Some(b) = b.filter(|b| solved(b)) {
+                    if let Some(b) = prepare_slot(bodies.at(bi as u32), (first + next) as u32, sb, flag) {
                         if let (Some(state), Some(sim)) = (states.get_mut(next), sims.get_mut(next)) {
                             *state = body_state(b);
                             *sim = body_sim(b, bi as u32, g);
@@ -938,6 +932,16 @@ const BODY_CHUNK: usize = 256;
 #[inline]
 fn solved(b: &Body) -> bool {
     b.awake && b.body_type != BodyType::Static
+}
+
+/// Writes a body slot's solver entry and awake flag (`b`: the slot's body, if any;
+/// `index`: its solver index, if it is [`solved`]); returns the body if it is solved (it
+/// then takes that index's state and step data).
+#[inline]
+fn prepare_slot<'b>(b: Option<&'b Body>, index: u32, sb: &mut SolverBody, flag: &mut bool) -> Option<&'b Body> {
+    *flag = b.is_some_and(solved);
+    *sb = solver_body(b, index);
+    b.filter(|b| solved(b))
 }
 
 /// Body `b`'s solver entry (`b`: the slot's body, if any); `index`: its solver index, if
