@@ -240,6 +240,9 @@ pub(crate) struct ContactSolver {
     pub(crate) layout_kept: bool,
     /// Steps that kept the last step's layout (for tests and diagnostics).
     pub(crate) kept_layouts: u64,
+    /// Counts the layouts made ([`ContactSolver::colour_and_lay_out`]): while it stands
+    /// still, each step's solved order ([`ContactSolver::solved_order`]) is last step's.
+    pub(crate) layouts: u64,
     // Scratch reused every step.
     /// Each candidate's colour (with the [`FAST`] and [`FRESH`] flags) or [`OVERFLOW`].
     colours: Vec<u8>,
@@ -518,6 +521,7 @@ impl ContactSolver {
         candidates: Candidates<'_>,
         light: &mut Vec<(u32, u32)>,
     ) {
+        self.layouts += 1;
         self.fresh.clear();
         self.last_keys.clear();
         self.layout_kept = true;
