@@ -945,13 +945,8 @@ impl World {
         let (xf, v) = (b.xf, box_velocity(b, self.def.max_linear_speed));
         let moved = (b.center - b.center0).length();
         for k in first..b.shapes.len() {
-            // The first shape's index is in the record (`Body::first_shape`): reading it
-            // from the list's heap buffer was a dependent miss per body, 60 % of this
-            // function in large_pyramid. Every listed shape is live.
-            let index = match k {
-                0 => b.first_shape,
-                _ => b.shapes.get(k).map_or(u32::MAX, |sid| sid.index),
-            };
+            // Every listed shape is live.
+            let index = b.shape_index(k);
             let Some(s) = self.shapes.at_mut(index) else {
                 continue;
             };
