@@ -40,8 +40,8 @@ use super::contact_solver::{
 use super::contact_wide::{self, StoredContact, WideCold, WideContact, WideHead, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
 use super::{
-    any_load, for_each_chunk_mut3, integrate_position_one, integrate_velocity_one, BodySim, ConstraintSet, SharedState,
-    StateCell, StateRead, StepContext, TeamProgress,
+    any_load, claim_each, for_each_chunk_mut3, integrate_position_one, integrate_velocity_one, BodySim, ConstraintSet,
+    SharedState, StateCell, StateRead, StepContext, TeamProgress,
 };
 use crate::collision::contact::{Contact, NO_COLOUR};
 use crate::math::Vec2;
@@ -820,7 +820,11 @@ impl ContactSolver {
     /// contact is written once, with the same values whatever the split. (Computing every
     /// lane's values into a buffer first and copying them in contact order, as this did
     /// before, streamed the buffer twice: large_pyramid's store took 0.64 ms on two threads
-    /// against 0.81 on one.)
+    /// against 0.81 on one.) More runs than threads, so that a thread that loses its core
+    /// would hold up less of the store, cost more than they save: the contacts follow the
+    /// layout only roughly (`World::reorder_contacts` allows one break in three), and cut
+    /// into eight runs large_pyramid had 1 509 contacts a step to write after, serially,
+    /// against 85 with two runs (store +30 % on two threads).
     pub fn store<S: StateRead + Sync>(&mut self, ctx: &StepContext, states: &[S], contacts: &mut [Option<Contact>]) {
         let groups = self.head.len();
         let tasks = if ctx.parallel {
@@ -854,16 +858,15 @@ impl ContactSolver {
                 runs.push((g..end_group, at, mine));
                 rest = tail;
             }
-            use rayon::prelude::*;
             let this = &*self;
-            let kept: Vec<Vec<(u32, u8, StoredContact)>> = runs
-                .into_par_iter()
-                .map(|(range, base, mine)| {
-                    let mut strays = Vec::new();
-                    this.store_groups(ctx, states, range, mine, base, &mut strays);
-                    strays
-                })
-                .collect();
+            let mut kept: Vec<Vec<(u32, u8, StoredContact)>> = vec![Vec::new(); runs.len()];
+            claim_each(
+                true,
+                runs.into_iter().zip(kept.iter_mut()),
+                |((range, base, mine), out)| {
+                    this.store_groups(ctx, states, range, mine, base, out);
+                },
+            );
             strays.extend(kept.into_iter().flatten());
         }
         for (contact, colour, stored) in strays {

@@ -61,9 +61,10 @@ pub(crate) struct BodyState {
 ///   by at most one thread; the static body (index 0) and kinematic bodies are only read
 ///   by constraints (their lanes' write flags are off);
 /// - body integration splits the bodies into disjoint ranges, one per task or block;
-/// - between colours and stages the threads meet at a barrier (rayon's join) or wait
-///   until every block of the pass is done ([`TeamProgress`]), both Release/Acquire, which
-///   orders one colour's writes before the next colour's reads.
+/// - between colours and stages the threads meet at the end of a rayon scope
+///   ([`claim_each`]) or wait until every block of the pass is done ([`TeamProgress`]),
+///   both Release/Acquire, which orders one colour's writes before the next colour's
+///   reads.
 ///
 /// Relaxed atomics did the same safely but cost 40 % of the substep loop: each 64-bit
 /// word had to be moved through an integer register and split into two floats, and loads
@@ -280,12 +281,7 @@ impl StateCell for SharedState {
         min_len: usize,
         f: impl Fn(usize, &mut T, &[Self]) + Sync + Send,
     ) {
-        use rayon::prelude::*;
-        items
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(min_len)
-            .for_each(|(i, x)| f(i, x, states));
+        for_each_mut(true, items, min_len, |i, x| f(i, x, states));
     }
     fn for_each_mut2<T: Send, U: Send>(
         states: &[Self],
@@ -294,16 +290,12 @@ impl StateCell for SharedState {
         min_len: usize,
         f: impl Fn(usize, &mut T, &mut U, &[Self]) + Sync + Send,
     ) {
-        use rayon::prelude::*;
-        a.par_iter_mut()
-            .zip(b.par_iter_mut())
-            .enumerate()
-            .with_min_len(min_len)
-            .for_each(|(i, (x, y))| f(i, x, y, states));
+        for_each_mut2(true, a, b, min_len, |i, x, y| f(i, x, y, states));
     }
     fn for_each_index(states: &[Self], n: usize, min_len: usize, f: impl Fn(usize, &[Self]) + Sync + Send) {
-        use rayon::prelude::*;
-        (0..n).into_par_iter().with_min_len(min_len).for_each(|i| f(i, states));
+        let len = min_len.max(1);
+        let blocks = (0..n.div_ceil(len)).map(|k| k * len..((k + 1) * len).min(n));
+        claim_each(true, blocks, |range| range.for_each(|i| f(i, states)));
     }
     fn as_shared(states: &[Self]) -> Option<&[SharedState]> {
         Some(states)
@@ -533,17 +525,85 @@ pub(crate) struct StepContext {
     pub parallel: bool,
 }
 
+/// Calls `f` on every item, in order on this thread, or when `parallel` on the pool's
+/// threads. The items are cut into one share of consecutive items per thread (as rayon
+/// splits a range: thread `k`'s share is the `k`-th part, so a stage that follows the
+/// solver's body order touches mostly what the same thread touched in the stage before);
+/// each thread claims its own share's items one at a time, then the next items of shares
+/// whose threads have not got to them (one counter per share), as the solver's worker team
+/// does and as Box2D v3's `b2ParallelFor` hands out blocks. This thread runs the other
+/// threads' shares itself when they have not started by the time it is done (rayon's
+/// scope runs its own pending jobs while it waits), so a thread that is late or loses its
+/// core holds up the step only while it holds one item. Rayon's parallel iterators hand
+/// out halves and quarters of the range instead, and a thread that lost its core after
+/// taking one held the others for the rest of its time slice: on two threads beside
+/// another busy process, large_pyramid's set-up, store and finalize took 2–3 × as long as
+/// on one thread.
+///
+/// `f` must not depend on the order in which items run (each writes only what no other
+/// writes), so the results are the same for any thread count.
+pub(crate) fn claim_each<T: Send>(parallel: bool, items: impl IntoIterator<Item = T>, f: impl Fn(T) + Sync) {
+    use core::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+    let threads = if parallel { rayon::current_num_threads() } else { 1 };
+    if threads < 2 {
+        items.into_iter().for_each(f);
+        return;
+    }
+    // An item sits in its slot until one thread takes it (each slot is locked once).
+    let slots: Vec<std::sync::Mutex<Option<T>>> = items.into_iter().map(|x| std::sync::Mutex::new(Some(x))).collect();
+    let n = slots.len();
+    let shares = threads.min(n);
+    if shares < 2 {
+        // One item (or none): this thread alone, without waking another.
+        for slot in slots {
+            if let Some(x) = slot.into_inner().unwrap_or_else(|e| e.into_inner()) {
+                f(x);
+            }
+        }
+        return;
+    }
+    let end = |k: usize| (k + 1) * n / shares;
+    // The next unclaimed item of each share.
+    let next: Vec<AtomicUsize> = (0..shares).map(|k| AtomicUsize::new(k * n / shares)).collect();
+    let work = |k: usize| {
+        for j in 0..shares {
+            let share = (k + j) % shares;
+            let Some(cursor) = next.get(share) else { continue };
+            loop {
+                let i = cursor.fetch_add(1, Relaxed);
+                if i >= end(share) {
+                    break;
+                }
+                let item = slots
+                    .get(i)
+                    .and_then(|slot| slot.lock().unwrap_or_else(|e| e.into_inner()).take());
+                if let Some(x) = item {
+                    f(x);
+                }
+            }
+        }
+    };
+    rayon::scope(|s| {
+        let work = &work;
+        for k in 1..shares {
+            s.spawn(move |_| work(k));
+        }
+        work(0);
+    });
+}
+
 /// Calls `f(i, &mut items[i])` for every item, split between the pool's threads when
-/// `parallel` (chunks of at least `min_len` items), else in order on this thread. `f` must
-/// not depend on the order (each item only writes itself and what no other item writes).
+/// `parallel` (chunks of `min_len` items, see [`claim_each`]), else in order on this
+/// thread. `f` must not depend on the order (each item only writes itself and what no
+/// other item writes).
 pub(crate) fn for_each_mut<T: Send>(parallel: bool, items: &mut [T], min_len: usize, f: impl Fn(usize, &mut T) + Sync) {
     if parallel {
-        use rayon::prelude::*;
-        items
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(min_len)
-            .for_each(|(i, x)| f(i, x));
+        let n = min_len.max(1);
+        claim_each(true, items.chunks_mut(n).enumerate(), |(k, chunk)| {
+            for (j, x) in chunk.iter_mut().enumerate() {
+                f(k * n + j, x);
+            }
+        });
     } else {
         for (i, x) in items.iter_mut().enumerate() {
             f(i, x);
@@ -561,12 +621,16 @@ pub(crate) fn for_each_mut2<A: Send, B: Send>(
     f: impl Fn(usize, &mut A, &mut B) + Sync,
 ) {
     if parallel {
-        use rayon::prelude::*;
-        a.par_iter_mut()
-            .zip(b.par_iter_mut())
-            .enumerate()
-            .with_min_len(min_len)
-            .for_each(|(i, (x, y))| f(i, x, y));
+        let n = min_len.max(1);
+        claim_each(
+            true,
+            a.chunks_mut(n).zip(b.chunks_mut(n)).enumerate(),
+            |(k, (xs, ys))| {
+                for (j, (x, y)) in xs.iter_mut().zip(ys.iter_mut()).enumerate() {
+                    f(k * n + j, x, y);
+                }
+            },
+        );
     } else {
         for (i, (x, y)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
             f(i, x, y);
@@ -586,13 +650,9 @@ pub(crate) fn for_each_chunk_mut3<A: Send, B: Send, C: Send>(
     f: impl Fn(usize, &mut [A], &mut [B], &mut [C]) + Sync,
 ) {
     if parallel {
-        use rayon::prelude::*;
         let n = min_len.max(1);
-        a.par_chunks_mut(n)
-            .zip(b.par_chunks_mut(n))
-            .zip(c.par_chunks_mut(n))
-            .enumerate()
-            .for_each(|(k, ((x, y), z))| f(k * n, x, y, z));
+        let chunks = a.chunks_mut(n).zip(b.chunks_mut(n)).zip(c.chunks_mut(n)).enumerate();
+        claim_each(true, chunks, |(k, ((x, y), z))| f(k * n, x, y, z));
     } else {
         f(0, a, b, c);
     }
@@ -607,14 +667,14 @@ pub(crate) fn for_each_chunk_mut4<A: Send, B: Send, C: Send, D: Send>(
 ) {
     let (a, b, c, d) = slices;
     if parallel {
-        use rayon::prelude::*;
         let n = min_len.max(1);
-        a.par_chunks_mut(n)
-            .zip(b.par_chunks_mut(n))
-            .zip(c.par_chunks_mut(n))
-            .zip(d.par_chunks_mut(n))
-            .enumerate()
-            .for_each(|(k, (((w, x), y), z))| f(k * n, w, x, y, z));
+        let chunks = a
+            .chunks_mut(n)
+            .zip(b.chunks_mut(n))
+            .zip(c.chunks_mut(n))
+            .zip(d.chunks_mut(n))
+            .enumerate();
+        claim_each(true, chunks, |(k, (((w, x), y), z))| f(k * n, w, x, y, z));
     } else {
         f(0, a, b, c, d);
     }
@@ -815,4 +875,47 @@ pub(crate) fn integrate_position_one<S: StateCell>(ctx: &StepContext, sim: &Body
     };
     s.dq = s.dq.integrate(h * s.w);
     state.set(s);
+}
+
+#[cfg(test)]
+mod claim_tests {
+    use super::{claim_each, for_each_chunk_mut3};
+    use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+
+    /// Every item runs exactly once, on two threads as on one, for counts below, at and
+    /// above the thread count (a shared counter per share: an item claimed twice would
+    /// count 2, one skipped 0).
+    #[test]
+    fn every_item_runs_once_on_any_thread_count() {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("pool");
+        for n in [0usize, 1, 2, 3, 17, 1000] {
+            for parallel in [false, true] {
+                let runs: Vec<AtomicU32> = (0..n).map(|_| AtomicU32::new(0)).collect();
+                pool.install(|| claim_each(parallel, 0..n, |i| _ = runs[i].fetch_add(1, Relaxed)));
+                assert!(
+                    runs.iter().all(|r| r.load(Relaxed) == 1),
+                    "n = {n}, parallel = {parallel}"
+                );
+            }
+        }
+    }
+
+    /// The chunked form hands each chunk its own first index: every element is written with
+    /// its own index, once, whatever thread wrote it.
+    #[test]
+    fn chunks_know_their_first_index() {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("pool");
+        let (mut a, mut b, mut c) = (vec![0usize; 1001], vec![0u8; 1001], vec![0u8; 1001]);
+        pool.install(|| {
+            for_each_chunk_mut3(true, &mut a, &mut b, &mut c, 32, |first, xs, ys, zs| {
+                for (k, ((x, y), z)) in xs.iter_mut().zip(ys.iter_mut()).zip(zs.iter_mut()).enumerate() {
+                    *x = first + k;
+                    *y += 1;
+                    *z += 1;
+                }
+            })
+        });
+        assert!(a.iter().enumerate().all(|(i, &x)| x == i));
+        assert!(b.iter().chain(&c).all(|&y| y == 1));
+    }
 }

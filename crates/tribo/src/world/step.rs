@@ -18,7 +18,8 @@ use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::{Candidate, Candidates, ColourKey};
 use crate::solver::contact_solver::ConstraintBodies;
 use crate::solver::{
-    for_each_chunk_mut4, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints, StepContext,
+    claim_each, for_each_chunk_mut4, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints,
+    StepContext,
 };
 use crate::world::Arena;
 use crate::world::{box_velocity, next_box};
@@ -597,17 +598,14 @@ impl World {
     /// entries, states and step data. Done serially this pass was a tenth of
     /// large_pyramid's two-thread set-up.
     fn prepare_bodies_parallel(&mut self, g: Vec2) {
-        use rayon::prelude::*;
         let bodies = &self.bodies;
         let capacity = self.solver_bodies.len();
-        let counts: Vec<usize> = (0..capacity.div_ceil(BODY_CHUNK))
-            .into_par_iter()
-            .map(|c| {
-                (c * BODY_CHUNK..((c + 1) * BODY_CHUNK).min(capacity))
-                    .filter(|&bi| bodies.at(bi as u32).is_some_and(solved))
-                    .count()
-            })
-            .collect();
+        let mut counts = vec![0usize; capacity.div_ceil(BODY_CHUNK)];
+        claim_each(true, counts.iter_mut().enumerate(), |(c, count)| {
+            *count = (c * BODY_CHUNK..((c + 1) * BODY_CHUNK).min(capacity))
+                .filter(|&bi| bodies.at(bi as u32).is_some_and(solved))
+                .count();
+        });
         let total: usize = counts.iter().sum();
         self.states.resize(total + 1, BodyState::default());
         self.sims.resize(total + 1, BodySim::default());
@@ -620,24 +618,25 @@ impl World {
             shares.push((first, st, si));
             (states, sims, first) = (st_rest, si_rest, first + n);
         }
-        self.solver_bodies
-            .par_chunks_mut(BODY_CHUNK)
-            .zip(self.scratch_flags.par_chunks_mut(BODY_CHUNK))
+        let chunks = self
+            .solver_bodies
+            .chunks_mut(BODY_CHUNK)
+            .zip(self.scratch_flags.chunks_mut(BODY_CHUNK))
             .zip(shares)
-            .enumerate()
-            .for_each(|(c, ((entries, flags), (first, states, sims)))| {
-                let mut next = 0usize;
-                for (k, (sb, flag)) in entries.iter_mut().zip(flags.iter_mut()).enumerate() {
-                    let bi = c * BODY_CHUNK + k;
-                    if let Some(b) = prepare_slot(bodies.at(bi as u32), (first + next) as u32, sb, flag) {
-                        if let (Some(state), Some(sim)) = (states.get_mut(next), sims.get_mut(next)) {
-                            *state = body_state(b);
-                            *sim = body_sim(b, bi as u32, g);
-                        }
-                        next += 1;
+            .enumerate();
+        claim_each(true, chunks, |(c, ((entries, flags), (first, states, sims)))| {
+            let mut next = 0usize;
+            for (k, (sb, flag)) in entries.iter_mut().zip(flags.iter_mut()).enumerate() {
+                let bi = c * BODY_CHUNK + k;
+                if let Some(b) = prepare_slot(bodies.at(bi as u32), (first + next) as u32, sb, flag) {
+                    if let (Some(state), Some(sim)) = (states.get_mut(next), sims.get_mut(next)) {
+                        *state = body_state(b);
+                        *sim = body_sim(b, bi as u32, g);
                     }
+                    next += 1;
                 }
-            });
+            }
+        });
     }
 
     /// Builds the solver's constraints from the candidates the narrow phase made, runs the
