@@ -602,18 +602,12 @@ pub(crate) fn claim_each<T: Send>(parallel: bool, items: impl IntoIterator<Item 
 /// thread. `f` must not depend on the order (each item only writes itself and what no
 /// other item writes).
 pub(crate) fn for_each_mut<T: Send>(parallel: bool, items: &mut [T], min_len: usize, f: impl Fn(usize, &mut T) + Sync) {
-    if parallel {
-        let n = min_len.max(1);
-        claim_each(true, items.chunks_mut(n).enumerate(), |(k, chunk)| {
-            for (j, x) in chunk.iter_mut().enumerate() {
-                f(k * n + j, x);
-            }
-        });
-    } else {
-        for (i, x) in items.iter_mut().enumerate() {
-            f(i, x);
+    let n = min_len.max(1);
+    claim_each(parallel, items.chunks_mut(n).enumerate(), |(k, chunk)| {
+        for (j, x) in chunk.iter_mut().enumerate() {
+            f(k * n + j, x);
         }
-    }
+    });
 }
 
 /// Calls `f(i, &mut a[i], &mut b[i])` for every index of both, split between the pool's
@@ -625,22 +619,13 @@ pub(crate) fn for_each_mut2<A: Send, B: Send>(
     min_len: usize,
     f: impl Fn(usize, &mut A, &mut B) + Sync,
 ) {
-    if parallel {
-        let n = min_len.max(1);
-        claim_each(
-            true,
-            a.chunks_mut(n).zip(b.chunks_mut(n)).enumerate(),
-            |(k, (xs, ys))| {
-                for (j, (x, y)) in xs.iter_mut().zip(ys.iter_mut()).enumerate() {
-                    f(k * n + j, x, y);
-                }
-            },
-        );
-    } else {
-        for (i, (x, y)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
-            f(i, x, y);
+    let n = min_len.max(1);
+    let chunks = a.chunks_mut(n).zip(b.chunks_mut(n)).enumerate();
+    claim_each(parallel, chunks, |(k, (xs, ys))| {
+        for (j, (x, y)) in xs.iter_mut().zip(ys.iter_mut()).enumerate() {
+            f(k * n + j, x, y);
         }
-    }
+    });
 }
 
 /// [`for_each_mut`] over three slices by chunks of `min_len`: `f(first, a, b, c)` gets a

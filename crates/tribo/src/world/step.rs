@@ -18,8 +18,8 @@ use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::{Candidate, Candidates, ColourKey};
 use crate::solver::contact_solver::ConstraintBodies;
 use crate::solver::{
-    claim_each, for_each_chunk_mut4, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints,
-    StepContext,
+    claim_each, for_each_chunk_mut4, for_each_mut, solve_step, BodySim, BodyState, SharedState, SolverBody,
+    StepConstraints, StepContext,
 };
 use crate::world::Arena;
 use crate::world::{box_velocity, next_box};
@@ -601,7 +601,7 @@ impl World {
         let bodies = &self.bodies;
         let capacity = self.solver_bodies.len();
         let mut counts = vec![0usize; capacity.div_ceil(BODY_CHUNK)];
-        claim_each(true, counts.iter_mut().enumerate(), |(c, count)| {
+        for_each_mut(true, &mut counts, 1, |c, count| {
             *count = (c * BODY_CHUNK..((c + 1) * BODY_CHUNK).min(capacity))
                 .filter(|&bi| bodies.at(bi as u32).is_some_and(solved))
                 .count();
