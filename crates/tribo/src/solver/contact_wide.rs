@@ -90,6 +90,38 @@ pub(crate) struct WideHead {
     pub rolling_impulse: F4,
 }
 
+impl WideHead {
+    /// Every field to zero, written in place field by field: `*self = WideHead::default()`
+    /// was compiled as a zeroed copy on the stack and a 400-byte `memcpy` (1.3 % of
+    /// large_pyramid's step in `perf`); this is one `memset` into the group. The build
+    /// and its `memcpy`/`memset` went from 8.2 % of the step's samples to 7.2–7.5 %.
+    #[inline(always)]
+    fn clear(&mut self) {
+        let (z, v) = (F4::ZERO, V4::default());
+        self.index_a = [0; LANES];
+        self.index_b = [0; LANES];
+        self.write_a = [false; LANES];
+        self.write_b = [false; LANES];
+        self.any_rolling = false;
+        self.normal = v;
+        self.inv_mass_a = z;
+        self.inv_i_a = z;
+        self.inv_mass_b = z;
+        self.inv_i_b = z;
+        self.split = z;
+        self.shift_cap2 = z;
+        for p in &mut self.points {
+            p.r_a = v;
+            p.r_b = v;
+            p.normal_impulse = z;
+            p.substep_vn = z;
+        }
+        self.tangent_impulse = z;
+        self.two_points = M4::default();
+        self.rolling_impulse = z;
+    }
+}
+
 /// The rest of four contact constraints, one per lane (see the module docs): what only
 /// the solve passes read.
 ///
@@ -604,7 +636,7 @@ pub(crate) fn build_group<S: StateRead>(
     let one = F4::splat(1.0);
     let half = F4::splat(0.5);
     // Written in place (a 1 KiB group built on the stack and copied costs more).
-    *head = WideHead::default();
+    head.clear();
     *w = WideContact::default();
     *cold = WideCold::default();
     let (hd, out, c) = (head, w, cold);
