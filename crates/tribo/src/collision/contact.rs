@@ -256,7 +256,7 @@ impl Contact {
     /// What [`Contact::update`] leaves when the shapes are too far apart for any point:
     /// no points, no carried-over state.
     pub fn clear_manifold(&mut self) {
-        self.manifold = Manifold::default();
+        self.manifold = Manifold::EMPTY;
         self.points = [PointState::default(); MAX_MANIFOLD_POINTS];
         self.rolling_impulse = 0.0;
         self.touching = false;

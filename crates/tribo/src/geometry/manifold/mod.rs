@@ -246,6 +246,12 @@ struct LocalPoint {
     /// Signed surface distance [m].
     separation: f32,
     id: u16,
+    /// Always 0: the record's two padding bytes made a field of their own. Without it the
+    /// zeroed record was written as two overlapping 8-byte stores (bytes 0–7 and 6–13,
+    /// skipping the padding), and the first load of its copy, reading bytes 0–7 from both,
+    /// could not be forwarded from the store buffer and waited for both to retire (a
+    /// quarter of the polygon collision's samples in tumbler).
+    _pad: u16,
 }
 
 /// A manifold under construction, in A's local frame.
@@ -271,7 +277,12 @@ impl LocalManifold {
     /// Adds a point when there is room and it is closer than `spec` (NaN is rejected).
     fn push(&mut self, point: Vec2, separation: f32, id: u16, spec: f32) {
         if self.count < MAX_MANIFOLD_POINTS && separation < spec {
-            self.points[self.count] = LocalPoint { point, separation, id };
+            self.points[self.count] = LocalPoint {
+                point,
+                separation,
+                id,
+                _pad: 0,
+            };
             self.count += 1;
         }
     }
