@@ -16,7 +16,6 @@ use crate::error::{Error, Result};
 use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::{Candidate, Candidates, ColourKey};
-use crate::solver::contact_solver::ConstraintBodies;
 use crate::solver::{
     claim_each, for_each_chunk_mut4, for_each_mut, solve_step, BodySim, BodyState, SharedState, SolverBody,
     StepConstraints, StepContext,
@@ -1085,22 +1084,7 @@ fn candidate(ci: u32, c: &Contact, solver_bodies: &[SolverBody], out: &mut Candi
     if !ba.awake_dynamic && !bb.awake_dynamic {
         return false;
     }
-    out.fill(
-        ci,
-        c.colour,
-        ConstraintBodies {
-            index_a: ba.index,
-            index_b: bb.index,
-            inv_mass_a: ba.inv_mass,
-            inv_i_a: ba.inv_i,
-            inv_mass_b: bb.inv_mass,
-            inv_i_b: bb.inv_i,
-            center_a: ba.center,
-            center_b: bb.center,
-        },
-        c,
-        key,
-    );
+    out.fill(ci, c.colour, ba, bb, c, key);
     true
 }
 
