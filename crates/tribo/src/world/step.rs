@@ -41,7 +41,10 @@ impl World {
         match self.pool.take() {
             Some(pool) => {
                 // Inside the pool the parallel stages split their work between its threads.
-                pool.install(|| self.run_step(dt, true));
+                pool.install(|| {
+                    let _awake = crate::solver::awake::Step::start();
+                    self.run_step(dt, true)
+                });
                 self.pool = Some(pool);
             }
             None => self.run_step(dt, false),
