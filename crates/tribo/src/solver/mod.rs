@@ -536,67 +536,74 @@ pub(crate) struct StepContext {
 /// stages. The spinner changes nothing but who waits: results do not depend on it.
 pub(crate) mod awake {
     use core::sync::atomic::{AtomicU64, Ordering};
-    use std::cell::Cell;
-
-    /// Bumped whenever work is posted (or a step ends): a spinner spawned before returns.
-    static EPOCH: AtomicU64 = AtomicU64::new(0);
+    use std::cell::RefCell;
+    use std::sync::Arc;
 
     thread_local! {
-        /// Set on the thread running a parallel step ([`Step`]): only then do spinners start.
-        static IN_STEP: Cell<bool> = const { Cell::new(false) };
+        /// The epoch of the step this thread is running ([`Step`]), bumped whenever work
+        /// is posted and when the step ends: a spinner returns when it moves. None outside
+        /// a parallel step (then no spinner starts). Per step, not per process: worlds
+        /// stepped side by side do not reach each other's spinners.
+        static STEP_EPOCH: RefCell<Option<Arc<AtomicU64>>> = const { RefCell::new(None) };
     }
 
     /// The longest a spinner waits [µs]: a bound on the time a core is held for nothing.
     const LIMIT_US: u128 = 1000;
 
-    /// Marks the thread as running a parallel step until dropped (which also stops the
-    /// spinners).
-    pub(crate) struct Step(());
+    /// Marks this thread as running a parallel step until dropped (which also stops the
+    /// step's spinners).
+    pub(crate) struct Step(Arc<AtomicU64>);
 
     impl Step {
         pub(crate) fn start() -> Step {
-            IN_STEP.with(|c| c.set(true));
-            Step(())
+            let epoch = Arc::new(AtomicU64::new(0));
+            STEP_EPOCH.with(|c| *c.borrow_mut() = Some(epoch.clone()));
+            Step(epoch)
         }
     }
 
     impl Drop for Step {
         fn drop(&mut self) {
-            IN_STEP.with(|c| c.set(false));
-            release();
+            STEP_EPOCH.with(|c| *c.borrow_mut() = None);
+            self.0.fetch_add(1, Ordering::AcqRel);
         }
     }
 
-    /// Work is about to be posted: running spinners return, so their threads take it.
+    /// Work is about to be posted: the step's running spinners return, so their threads
+    /// take it.
     #[inline]
     pub(crate) fn release() {
-        EPOCH.fetch_add(1, Ordering::AcqRel);
+        STEP_EPOCH.with(|c| {
+            if let Some(epoch) = &*c.borrow() {
+                epoch.fetch_add(1, Ordering::AcqRel);
+            }
+        });
     }
 
     /// After a parallel stage, inside a step: one spinner for each of the pool's other
-    /// `threads − 1` threads, but no more than the machine has other cores (spinners on a
-    /// pool larger than the machine would take cores from the stepping thread).
+    /// `threads − 1` threads. Each yields its core every 256 spins, so on a pool larger than
+    /// the machine the stepping thread is not kept waiting for a core by spinners.
     pub(crate) fn hold(threads: usize) {
-        if !IN_STEP.with(|c| c.get()) {
+        let Some(epoch) = STEP_EPOCH.with(|c| c.borrow().clone()) else {
             return;
-        }
-        static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
-        let cores = *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-        let epoch = EPOCH.load(Ordering::Acquire);
-        for _ in 1..threads.min(cores) {
+        };
+        let at = epoch.load(Ordering::Acquire);
+        for _ in 1..threads {
+            let epoch = epoch.clone();
             rayon::spawn(move || {
                 // A spinner found by the stepping thread itself (in a later wait) or late
                 // finds the epoch moved on and returns at once.
                 let start = std::time::Instant::now();
                 let mut spins = 0u32;
-                while EPOCH.load(Ordering::Acquire) == epoch {
+                while epoch.load(Ordering::Acquire) == at {
                     core::hint::spin_loop();
                     spins = spins.wrapping_add(1);
                     if spins % 256 == 0 {
                         if start.elapsed().as_micros() > LIMIT_US {
                             break;
                         }
-                        // A thread that needs this core (another process's) gets it.
+                        // A thread that needs this core (the stepping thread on a pool
+                        // larger than the machine, another process) gets it.
                         std::thread::yield_now();
                     }
                 }
