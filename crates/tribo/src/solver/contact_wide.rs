@@ -674,7 +674,8 @@ pub(crate) fn build_group<S: StateRead>(
     // (zero in empty lanes and absent points). Stored lane by lane and read back as
     // vectors, as before, the first vector load could not be forwarded from the four
     // scalar stores it spans and waited for every store before it to drain, the group's
-    // clearing included: a fifth of the build's samples (large_pyramid: 1.7 % of the step).
+    // clearing included: a fifth of the build's samples; the build and its `memset`s went
+    // from 11.2 % to 10.7 % of large_pyramid's step.
     let each = |f: &dyn Fn(&ContactInput, &ConstraintBodies) -> f32| {
         F4(core::array::from_fn(|l| {
             lanes[l].map_or(0.0, |(_, input, b)| f(input, b))
