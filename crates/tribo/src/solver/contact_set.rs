@@ -40,8 +40,8 @@ use super::contact_solver::{
 use super::contact_wide::{self, StoredContact, WideCold, WideContact, WideHead, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
 use super::{
-    any_load, claim_each, for_each_chunk_mut3, integrate_position_one, integrate_velocity_one, BodySim, ConstraintSet,
-    SharedState, SolverBody, StateCell, StateRead, StepContext, TeamProgress,
+    any_load, claim_each, for_each_chunk_mut3, integrate_positions_range, integrate_velocity_one, BodySim,
+    ConstraintSet, SharedState, SolverBody, StateCell, StateRead, StepContext, TeamProgress,
 };
 use crate::collision::contact::{Contact, NO_COLOUR};
 use crate::math::Vec2;
@@ -1144,9 +1144,7 @@ impl ContactSolver {
                 });
                 t[2] += lap.lap();
                 team_pass(&bodies, k, &mut at, &progress, |range| {
-                    for b in range.clone() {
-                        integrate_position_one(ctx, &sims[b], &states[b]);
-                    }
+                    integrate_positions_range(ctx, sims, states, range.clone());
                 });
                 t[3] += lap.lap();
                 each_colour(&mut at, &|h, w| {

@@ -925,23 +925,72 @@ pub(crate) fn integrate_velocity_one<S: StateCell>(h: f32, sim: &BodySim, state:
 /// (plain symplectic Euler overshoots by ½h²a per substep, which makes a dropped ball hit
 /// slower and bounce lower than e²h by about (1 + 1/e)·g·h/v).
 fn integrate_positions<S: StateCell>(ctx: &StepContext, sims: &[BodySim], states: &[S]) {
-    S::for_each_index(states, sims.len(), BODY_CHUNK, |k, states| {
-        if k == 0 {
-            return;
-        }
-        integrate_position_one(ctx, &sims[k], &states[k]);
-    });
+    // Index 0 is the shared static body: it never moves. Blocks of four bodies.
+    let n = sims.len();
+    S::for_each_index(
+        states,
+        n.div_ceil(wide::LANES),
+        BODY_CHUNK / wide::LANES,
+        |q, states| {
+            let first = q * wide::LANES;
+            integrate_positions_range(ctx, sims, states, first.max(1)..(first + wide::LANES).min(n));
+        },
+    );
 }
 
-/// [`integrate_positions`] for one body.
-#[inline]
-pub(crate) fn integrate_position_one<S: StateCell>(ctx: &StepContext, sim: &BodySim, state: &S) {
+/// [`integrate_position_one`] for the bodies of `range`, four at a time where it can: the
+/// same expressions, but each rotation's normalisation (a square root and a division, the
+/// slowest instructions of the pass: with one body at a time they were most of its time)
+/// done for four bodies by one vector square root and one vector division, which round
+/// each lane exactly as the scalar ones do.
+pub(crate) fn integrate_positions_range<S: StateCell>(
+    ctx: &StepContext,
+    sims: &[BodySim],
+    states: &[S],
+    range: core::ops::Range<usize>,
+) {
     let h = ctx.h;
-    // Rotation per substep is limited to 0.25π per full step, as in Box2D, so the
-    // first-order rotation update stays accurate.
+    let max_w = 0.25 * core::f32::consts::PI / ctx.dt;
+    let mut k = range.start;
+    while k + wide::LANES <= range.end {
+        let (Some(block), Some(block_sims)) = (states.get(k..k + wide::LANES), sims.get(k..k + wide::LANES)) else {
+            break;
+        };
+        // The rotation after the turn of the substep, before it is normalised
+        // (`Rot::integrate`), from each body's clamped angular velocity.
+        let turned = |l: usize| {
+            let s = block[l].get();
+            let da = h * s.w.clamp(-max_w, max_w);
+            (s.dq.c - da * s.dq.s, s.dq.s + da * s.dq.c)
+        };
+        let (c, sn) = (
+            wide::F4(core::array::from_fn(|l| turned(l).0)),
+            wide::F4(core::array::from_fn(|l| turned(l).1)),
+        );
+        let mag = (c * c + sn * sn).sqrt();
+        let zero = wide::F4::ZERO;
+        let inv = mag.gt(zero).select(wide::F4::splat(1.0) / mag, zero);
+        let (qc, qs) = (c * inv, sn * inv);
+        for (l, (state, sim)) in block.iter().zip(block_sims).enumerate() {
+            let mut s = integrate_translation(ctx, sim, state.get());
+            s.dq = crate::math::Rot { c: qc.0[l], s: qs.0[l] };
+            state.set(s);
+        }
+        k += wide::LANES;
+    }
+    for b in k..range.end {
+        if let (Some(sim), Some(state)) = (sims.get(b), states.get(b)) {
+            integrate_position_one(ctx, sim, state);
+        }
+    }
+}
+
+/// What [`integrate_position_one`] does but the rotation: the speed limits and Δp.
+#[inline(always)]
+fn integrate_translation(ctx: &StepContext, sim: &BodySim, mut s: BodyState) -> BodyState {
+    let h = ctx.h;
     let max_w = 0.25 * core::f32::consts::PI / ctx.dt;
     let max_v2 = ctx.max_linear_speed * ctx.max_linear_speed;
-    let mut s = state.get();
     if s.v.length_squared() > max_v2 {
         s.v = s.v * (ctx.max_linear_speed / s.v.length());
     }
@@ -952,7 +1001,16 @@ pub(crate) fn integrate_position_one<S: StateCell>(ctx: &StepContext, sim: &Body
     } else {
         h * s.v
     };
-    s.dq = s.dq.integrate(h * s.w);
+    s
+}
+
+/// [`integrate_positions`] for one body.
+#[inline]
+pub(crate) fn integrate_position_one<S: StateCell>(ctx: &StepContext, sim: &BodySim, state: &S) {
+    // Rotation per substep is limited to 0.25π per full step, as in Box2D, so the
+    // first-order rotation update stays accurate (`integrate_translation` clamps ω).
+    let mut s = integrate_translation(ctx, sim, state.get());
+    s.dq = s.dq.integrate(ctx.h * s.w);
     state.set(s);
 }
 
