@@ -150,6 +150,14 @@ impl ColourKey {
     pub fn slots(&self) -> (u32, u32) {
         (self.index_a, self.index_b)
     }
+
+    /// The solver slots of the two bodies when both are awake dynamic bodies (the pairs
+    /// that join islands), else None.
+    #[inline]
+    pub fn dynamic_pair(&self) -> Option<(u32, u32)> {
+        let both = KEY_DYNAMIC_A | KEY_DYNAMIC_B;
+        (self.flags & both == both).then_some((self.index_a, self.index_b))
+    }
 }
 
 /// Flag of a [`ColourKey`]: side A is a moving body (takes a colour).

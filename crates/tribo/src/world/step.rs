@@ -856,7 +856,11 @@ impl World {
         {
             return;
         }
-        let n = self.bodies.capacity();
+        // Islands over the solver slots of the awake bodies (solver order is slot order, so
+        // an island's smallest solver slot belongs to its smallest body slot, and the
+        // islands come out in the same order as over body slots).
+        let n = self.states.len();
+        let slot = |bi: u32| self.solver_bodies.get(bi as usize).map_or(0, |sb| sb.index);
         let mut parent = core::mem::take(&mut self.scratch_u32);
         parent.clear();
         parent.extend(0..n as u32);
@@ -868,24 +872,34 @@ impl World {
             }
             x
         }
-        // Touching contacts and joints link awake dynamic bodies into islands.
-        let links = self
-            .touching_contacts
-            .iter()
-            .filter_map(|&ci| self.contacts.get(ci as usize)?.as_ref())
-            .filter(|c| c.touching)
-            .map(|c| (c.body_a, c.body_b))
-            .chain(self.joints.iter().map(|(_, j)| (j.body_a, j.body_b)));
-        for (ia, ib) in links {
-            let (Some(a), Some(b)) = (self.bodies.at(ia), self.bodies.at(ib)) else {
+        fn union(p: &mut [u32], a: u32, b: u32) {
+            let (ra, rb) = (find(p, a), find(p, b));
+            if ra != rb {
+                // Union by smaller index: each island's root is its smallest slot.
+                let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+                p[hi as usize] = lo;
+            }
+        }
+        // Touching contacts between two awake dynamic bodies link them: those are solved
+        // contacts, whose colouring keys hold both slots (12 bytes each; reading the
+        // contact records and both bodies' records for every touching contact was most of
+        // this pass in junkyard).
+        for &ci in &self.solver_contacts {
+            if let Some((a, b)) = self.colour_keys.get(ci as usize).and_then(|k| k.dynamic_pair()) {
+                if (a as usize) < n && (b as usize) < n {
+                    union(&mut parent, a, b);
+                }
+            }
+        }
+        // Joints between awake dynamic bodies.
+        for (_, j) in self.joints.iter() {
+            let (Some(a), Some(b)) = (self.bodies.at(j.body_a), self.bodies.at(j.body_b)) else {
                 continue;
             };
             if a.is_dynamic() && b.is_dynamic() && a.awake && b.awake {
-                let (ra, rb) = (find(&mut parent, ia), find(&mut parent, ib));
-                if ra != rb {
-                    // Union by smaller index: deterministic roots.
-                    let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-                    parent[hi as usize] = lo;
+                let (sa, sb) = (slot(j.body_a), slot(j.body_b));
+                if sa != 0 && sb != 0 && (sa as usize) < n && (sb as usize) < n {
+                    union(&mut parent, sa, sb);
                 }
             }
         }
@@ -895,7 +909,7 @@ impl World {
         let mut any = false;
         for (bi, b) in self.bodies.iter() {
             if b.awake && b.is_dynamic() {
-                let r = find(&mut parent, bi) as usize;
+                let r = find(&mut parent, slot(bi)) as usize;
                 min_time[r] = min_time[r].min(b.sleep_time);
                 any = true;
             }
@@ -905,7 +919,7 @@ impl World {
             let mut members_of_root: std::collections::BTreeMap<u32, Vec<u32>> = Default::default();
             for (bi, b) in self.bodies.iter() {
                 if b.awake && b.is_dynamic() {
-                    let r = find(&mut parent, bi);
+                    let r = find(&mut parent, slot(bi));
                     if min_time[r as usize] >= tts {
                         members_of_root.entry(r).or_default().push(bi);
                     }
