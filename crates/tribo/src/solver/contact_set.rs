@@ -1168,15 +1168,15 @@ impl ContactSolver {
         // other thread has started when this one is done runs here, and finds every pass
         // done (rayon's scope runs its own pending jobs while it waits), so the step never
         // waits for a thread that is not running.
-        super::awake::release();
-        rayon::scope(|s| {
-            for k in 1..threads {
-                let work = &work;
-                s.spawn(move |_| work(k));
-            }
-            work(0);
+        super::awake::stage(threads, || {
+            rayon::scope(|s| {
+                for k in 1..threads {
+                    let work = &work;
+                    s.spawn(move |_| work(k));
+                }
+                work(0);
+            })
         });
-        super::awake::hold(threads);
         *times = times_out.into_inner().unwrap_or_else(|e| e.into_inner());
         true
     }

@@ -531,8 +531,8 @@ pub(crate) struct StepContext {
 /// project's VM a sleeping worker starts a job spawned for it about 20 µs late (measured:
 /// 1 400 spawns, seven parallel stages a step), while the spawning thread starts at once.
 /// So during a step, after each parallel stage, the other threads are given a job that
-/// spins ([`hold`]) until the next stage is posted ([`release`], which every spawning
-/// site calls first) or a millisecond has passed, as Box2D v3's workers spin between its
+/// spins (`hold`) until the next stage is posted (`release`; every spawning site runs
+/// its scope through [`awake::stage`], which does both) or a millisecond has passed, as Box2D v3's workers spin between its
 /// stages. The spinner changes nothing but who waits: results do not depend on it.
 pub(crate) mod awake {
     use core::sync::atomic::{AtomicU64, Ordering};
@@ -572,7 +572,7 @@ pub(crate) mod awake {
     /// Work is about to be posted: the step's running spinners return, so their threads
     /// take it.
     #[inline]
-    pub(crate) fn release() {
+    fn release() {
         STEP_EPOCH.with(|c| {
             if let Some(epoch) = &*c.borrow() {
                 epoch.fetch_add(1, Ordering::AcqRel);
@@ -580,10 +580,20 @@ pub(crate) mod awake {
         });
     }
 
+    /// Runs `stage` (one parallel stage of `threads` threads: a rayon scope) between
+    /// [`release`] and [`hold`], as every spawning site must.
+    #[inline]
+    pub(crate) fn stage<R>(threads: usize, stage: impl FnOnce() -> R) -> R {
+        release();
+        let out = stage();
+        hold(threads);
+        out
+    }
+
     /// After a parallel stage, inside a step: one spinner for each of the pool's other
     /// `threads − 1` threads. Each yields its core every 256 spins, so on a pool larger than
     /// the machine the stepping thread is not kept waiting for a core by spinners.
-    pub(crate) fn hold(threads: usize) {
+    fn hold(threads: usize) {
         let Some(epoch) = STEP_EPOCH.with(|c| c.borrow().clone()) else {
             return;
         };
@@ -675,15 +685,15 @@ pub(crate) fn claim_each<T: Send>(parallel: bool, items: impl IntoIterator<Item 
             }
         }
     };
-    awake::release();
-    rayon::scope(|s| {
-        let work = &work;
-        for k in 1..shares {
-            s.spawn(move |_| work(k));
-        }
-        work(0);
+    awake::stage(threads, || {
+        rayon::scope(|s| {
+            let work = &work;
+            for k in 1..shares {
+                s.spawn(move |_| work(k));
+            }
+            work(0);
+        })
     });
-    awake::hold(threads);
 }
 
 /// Calls `f(i, &mut items[i])` for every item, split between the pool's threads when
@@ -950,7 +960,7 @@ pub(crate) fn integrate_positions_range<S: StateCell>(
     range: core::ops::Range<usize>,
 ) {
     let h = ctx.h;
-    let max_w = 0.25 * core::f32::consts::PI / ctx.dt;
+    let max_w = max_angular_speed(ctx);
     let mut k = range.start;
     while k + wide::LANES <= range.end {
         let (Some(block), Some(block_sims)) = (states.get(k..k + wide::LANES), sims.get(k..k + wide::LANES)) else {
@@ -958,15 +968,12 @@ pub(crate) fn integrate_positions_range<S: StateCell>(
         };
         // The rotation after the turn of the substep, before it is normalised
         // (`Rot::integrate`), from each body's clamped angular velocity.
-        let turned = |l: usize| {
+        let turned: [(f32, f32); wide::LANES] = core::array::from_fn(|l| {
             let s = block[l].get();
             let da = h * s.w.clamp(-max_w, max_w);
             (s.dq.c - da * s.dq.s, s.dq.s + da * s.dq.c)
-        };
-        let (c, sn) = (
-            wide::F4(core::array::from_fn(|l| turned(l).0)),
-            wide::F4(core::array::from_fn(|l| turned(l).1)),
-        );
+        });
+        let (c, sn) = (wide::F4(turned.map(|t| t.0)), wide::F4(turned.map(|t| t.1)));
         let mag = (c * c + sn * sn).sqrt();
         let zero = wide::F4::ZERO;
         let inv = mag.gt(zero).select(wide::F4::splat(1.0) / mag, zero);
@@ -985,11 +992,19 @@ pub(crate) fn integrate_positions_range<S: StateCell>(
     }
 }
 
+/// The largest angular speed [rad/s] a body integrates with: a rotation per substep of at
+/// most 0.25π per full step, as in Box2D, so the first-order rotation update stays
+/// accurate.
+#[inline(always)]
+fn max_angular_speed(ctx: &StepContext) -> f32 {
+    0.25 * core::f32::consts::PI / ctx.dt
+}
+
 /// What [`integrate_position_one`] does but the rotation: the speed limits and Δp.
 #[inline(always)]
 fn integrate_translation(ctx: &StepContext, sim: &BodySim, mut s: BodyState) -> BodyState {
     let h = ctx.h;
-    let max_w = 0.25 * core::f32::consts::PI / ctx.dt;
+    let max_w = max_angular_speed(ctx);
     let max_v2 = ctx.max_linear_speed * ctx.max_linear_speed;
     if s.v.length_squared() > max_v2 {
         s.v = s.v * (ctx.max_linear_speed / s.v.length());
@@ -1007,8 +1022,7 @@ fn integrate_translation(ctx: &StepContext, sim: &BodySim, mut s: BodyState) -> 
 /// [`integrate_positions`] for one body.
 #[inline]
 pub(crate) fn integrate_position_one<S: StateCell>(ctx: &StepContext, sim: &BodySim, state: &S) {
-    // Rotation per substep is limited to 0.25π per full step, as in Box2D, so the
-    // first-order rotation update stays accurate (`integrate_translation` clamps ω).
+    // `integrate_translation` clamps ω to `max_angular_speed`.
     let mut s = integrate_translation(ctx, sim, state.get());
     s.dq = s.dq.integrate(ctx.h * s.w);
     state.set(s);
