@@ -30,6 +30,7 @@ use crate::geometry::{Shape, LINEAR_SLOP, SPECULATIVE_DISTANCE};
 use crate::math::{Aabb, Transform, Vec2};
 use crate::solver::contact_set::{Candidate, ColourKey, ContactSolver};
 use crate::solver::{BodySim, BodyState};
+use step::ChunkOutcomes;
 
 /// World settings. Every field has a default (listed on the field) that matches Box2D v3
 /// where Box2D has the same setting, so scenes port.
@@ -195,13 +196,16 @@ pub struct World {
     /// What the colouring reads of each candidate (indexed by contact, like `candidates`).
     pub(crate) colour_keys: Vec<ColourKey>,
     /// The narrow phase's verdict on each contact slot it visited this step, and whether
-    /// the contact has a candidate (dense: the serial pass after the narrow phase reads
-    /// these instead of the contact records).
+    /// the contact has a candidate (dense: written by the narrow phase's loop, filed into
+    /// the chunks' lists after it).
     pub(crate) outcomes: Vec<(NarrowOutcome, bool)>,
+    /// What each chunk of the narrow phase found, one entry per chunk of contacts (see
+    /// `World::collide`).
+    pub(crate) chunk_outcomes: Vec<std::sync::Mutex<ChunkOutcomes>>,
     /// The touching contacts the solver takes this step, in contact order.
     pub(crate) solver_contacts: Vec<u32>,
     /// Contacts the narrow phase of the current step listed: those with an awake moving
-    /// body, or every contact slot when most bodies are awake (each then tests its bodies).
+    /// body; none when most bodies are awake (each contact then tests its bodies).
     pub(crate) active_contacts: Vec<u32>,
     /// The touching ones among them after the narrow phase (solver and islands).
     pub(crate) touching_contacts: Vec<u32>,
@@ -274,6 +278,7 @@ impl World {
             candidates: Vec::new(),
             colour_keys: Vec::new(),
             outcomes: Vec::new(),
+            chunk_outcomes: Vec::new(),
             solver_contacts: Vec::new(),
             active_contacts: Vec::new(),
             touching_contacts: Vec::new(),
