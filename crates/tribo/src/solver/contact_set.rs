@@ -477,14 +477,16 @@ fn dynamic_side(inv_mass: f32, inv_i: f32) -> bool {
 impl ContactSolver {
     /// Builds the step's constraints from `candidates` (in contact order, each carrying its
     /// contact's solver input); `states` and `sims` are the awake bodies' solver states and
-    /// step data.
+    /// step data, `loaded` whether any of them [`super::loads`] (found while they were made).
     pub fn build<S: StateRead + Sync>(
         &mut self,
         ctx: &StepContext,
         states: &[S],
         sims: &[BodySim],
         candidates: Candidates<'_>,
+        loaded: bool,
     ) {
+        debug_assert_eq!(loaded, any_load(sims));
         self.overflow.clear();
         self.groups.clear();
         self.soft = StepSoftness::new(ctx);
@@ -535,7 +537,7 @@ impl ContactSolver {
                 }
             },
         );
-        self.loaded = any_load(sims);
+        self.loaded = loaded;
         if self.loaded {
             self.build_groups(light, candidates);
         }

@@ -898,8 +898,13 @@ pub(crate) fn solve_step<S: StateCell, C: ConstraintSet>(
 /// are the solver's ordinary work), so the helpers for carrying loads — the estimate of
 /// new resting contacts and the extra sweeps of light bodies under heavy ones — are off.
 pub(crate) fn any_load(sims: &[BodySim]) -> bool {
-    sims.iter()
-        .any(|s| s.linear_accel != Vec2::ZERO || s.angular_accel != 0.0)
+    sims.iter().any(loads)
+}
+
+/// Whether gravity or an applied force or torque acts on a body (see [`any_load`]).
+#[inline]
+pub(crate) fn loads(s: &BodySim) -> bool {
+    s.linear_accel != Vec2::ZERO || s.angular_accel != 0.0
 }
 
 /// Bodies per parallel chunk of the integration stages.

@@ -204,11 +204,15 @@ pub struct World {
     pub(crate) chunk_outcomes: Vec<std::sync::Mutex<ChunkOutcomes>>,
     /// The touching contacts the solver takes this step, in contact order.
     pub(crate) solver_contacts: Vec<u32>,
+    /// Whether a force acts on some awake body this step (`solver::any_load` of `sims`,
+    /// found by `World::prepare_bodies` while it makes them).
+    pub(crate) any_load: bool,
     /// Contacts the narrow phase of the current step listed: those with an awake moving
     /// body; none when most bodies are awake (each contact then tests its bodies).
     pub(crate) active_contacts: Vec<u32>,
-    /// The touching ones among them after the narrow phase (solver and islands).
-    pub(crate) touching_contacts: Vec<u32>,
+    /// The touching contacts the narrow phase visited that the solver does not take (no
+    /// awake dynamic side), in contact order: with `solver_contacts`, every touching one.
+    pub(crate) unsolved_contacts: Vec<u32>,
     pub(crate) scratch_u32: Vec<u32>,
     pub(crate) scratch_f32: Vec<f32>,
     pub(crate) scratch_mark: Vec<bool>,
@@ -280,8 +284,9 @@ impl World {
             outcomes: Vec::new(),
             chunk_outcomes: Vec::new(),
             solver_contacts: Vec::new(),
+            any_load: false,
             active_contacts: Vec::new(),
-            touching_contacts: Vec::new(),
+            unsolved_contacts: Vec::new(),
             scratch_u32: Vec::new(),
             scratch_f32: Vec::new(),
             scratch_mark: Vec::new(),

@@ -17,7 +17,7 @@ use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::{Candidate, Candidates, ColourKey};
 use crate::solver::{
-    claim_each, for_each_chunk_mut4, for_each_mut, solve_step, BodySim, BodyState, SharedState, SolverBody,
+    claim_each, for_each_chunk_mut4, for_each_mut, loads, solve_step, BodySim, BodyState, SharedState, SolverBody,
     StepConstraints, StepContext,
 };
 use crate::world::Arena;
@@ -478,16 +478,16 @@ impl World {
         self.scratch_flags = flags;
         let mut to_destroy = Vec::new();
         let mut to_wake = Vec::new();
-        let mut touching = core::mem::take(&mut self.touching_contacts);
+        let mut unsolved = core::mem::take(&mut self.unsolved_contacts);
         let mut solvable = core::mem::take(&mut self.solver_contacts);
-        touching.clear();
+        unsolved.clear();
         solvable.clear();
         // The chunks' lists in contact order; a contact's record is read only when its
         // touching changed.
         for list in &mut lists {
             let list = list.get_mut().unwrap_or_else(|e| e.into_inner());
-            touching.extend_from_slice(&list.touching);
             solvable.extend_from_slice(&list.solvable);
+            unsolved.extend_from_slice(&list.unsolved);
             for &(ci, outcome) in &list.special {
                 let NarrowOutcome::Updated { touching: now, .. } = outcome else {
                     to_destroy.push(ci);
@@ -531,20 +531,24 @@ impl World {
             // entries and every touching contact's candidate are made again.
             self.prepare_bodies(parallel);
             let flags = core::mem::take(&mut self.scratch_flags);
+            let mut touching = Vec::new();
             self.collect_active_contacts(&mut touching, &flags, self.mostly_awake, true);
             self.scratch_flags = flags;
             solvable.clear();
+            unsolved.clear();
             for &ci in &touching {
                 if let Some(Some(c)) = self.contacts.get(ci as usize) {
                     if let (Some(slot), Some(key)) = (candidates.get_mut(ci as usize), keys.get_mut(ci as usize)) {
                         if candidate(ci, c, &self.solver_bodies, slot, key) {
                             solvable.push(ci);
+                        } else {
+                            unsolved.push(ci);
                         }
                     }
                 }
             }
         }
-        self.touching_contacts = touching;
+        self.unsolved_contacts = unsolved;
         self.solver_contacts = solvable;
         self.candidates = candidates;
         self.colour_keys = keys;
@@ -607,6 +611,7 @@ impl World {
             self.sims.clear();
             self.states.push(BodyState::default()); // index 0: every static body
             self.sims.push(BodySim::default());
+            let mut loaded = false;
             for (bi, (sb, flag)) in self
                 .solver_bodies
                 .iter_mut()
@@ -614,10 +619,13 @@ impl World {
                 .enumerate()
             {
                 if let Some(b) = prepare_slot(self.bodies.at(bi as u32), self.states.len() as u32, sb, flag) {
+                    let sim = body_sim(b, bi as u32, g);
+                    loaded |= loads(&sim);
                     self.states.push(body_state(b));
-                    self.sims.push(body_sim(b, bi as u32, g));
+                    self.sims.push(sim);
                 }
             }
+            self.any_load = loaded;
         }
         // Bodies whose contacts the narrow phase visits (awake and not static): most of
         // them, or few (see `World::collide`).
@@ -662,19 +670,25 @@ impl World {
             .zip(self.scratch_flags.chunks_mut(BODY_CHUNK))
             .zip(shares)
             .enumerate();
+        let loaded = core::sync::atomic::AtomicBool::new(false);
         claim_each(true, chunks, |(c, ((entries, flags), (first, states, sims)))| {
-            let mut next = 0usize;
+            let (mut next, mut any) = (0usize, false);
             for (k, (sb, flag)) in entries.iter_mut().zip(flags.iter_mut()).enumerate() {
                 let bi = c * BODY_CHUNK + k;
                 if let Some(b) = prepare_slot(bodies.at(bi as u32), (first + next) as u32, sb, flag) {
                     if let (Some(state), Some(sim)) = (states.get_mut(next), sims.get_mut(next)) {
                         *state = body_state(b);
                         *sim = body_sim(b, bi as u32, g);
+                        any |= loads(sim);
                     }
                     next += 1;
                 }
             }
+            if any {
+                loaded.store(true, core::sync::atomic::Ordering::Relaxed);
+            }
         });
+        self.any_load = loaded.into_inner();
     }
 
     /// Builds the solver's constraints from the candidates the narrow phase made, runs the
@@ -686,7 +700,7 @@ impl World {
         let mut solver = core::mem::take(&mut self.contact_solver);
         solver.up = (-g).normalize_or_zero();
         let candidates = Candidates::new(&self.candidates, &self.colour_keys, &self.solver_contacts);
-        solver.build(ctx, &self.states, &self.sims, candidates);
+        solver.build(ctx, &self.states, &self.sims, candidates, self.any_load);
         self.build_joints(ctx);
         self.profile.solver_setup = bodies_ms + lap.lap();
         let mut joints = core::mem::take(&mut self.joint_solver);
@@ -852,24 +866,23 @@ impl World {
             return;
         }
         // The solved contacts' slots are in their colouring keys (12 bytes each, not the
-        // contact records' lines: tumbler's loop stalled on those); the solved contacts are
-        // the touching ones in the same order, less those without an awake dynamic side,
-        // whose records are read.
-        let mut solved = self.solver_contacts.iter().peekable();
-        for &ci in &self.touching_contacts {
-            let pair = if solved.next_if_eq(&&ci).is_some() {
-                self.colour_keys.get(ci as usize).map(|k| k.slots())
-            } else {
-                self.contacts.get(ci as usize).and_then(Option::as_ref).map(|c| {
-                    let slot = |body: u32| self.solver_bodies.get(body as usize).map_or(0, |sb| sb.index);
-                    (slot(c.body_a), slot(c.body_b))
-                })
-            };
-            if let Some((a, b)) = pair {
-                for slot in [a, b] {
-                    if let Some(t) = touched.get_mut(slot as usize) {
-                        *t = true;
-                    }
+        // contact records' lines: tumbler's loop stalled on those); the records are read
+        // only for the touching contacts without an awake dynamic side.
+        let keyed = self
+            .solver_contacts
+            .iter()
+            .filter_map(|&ci| self.colour_keys.get(ci as usize))
+            .map(|k| k.slots());
+        let unsolved = self.unsolved_contacts.iter().filter_map(|&ci| {
+            self.contacts.get(ci as usize).and_then(Option::as_ref).map(|c| {
+                let slot = |body: u32| self.solver_bodies.get(body as usize).map_or(0, |sb| sb.index);
+                (slot(c.body_a), slot(c.body_b))
+            })
+        });
+        for (a, b) in keyed.chain(unsolved) {
+            for slot in [a, b] {
+                if let Some(t) = touched.get_mut(slot as usize) {
+                    *t = true;
                 }
             }
         }
@@ -1050,21 +1063,23 @@ fn body_sim(b: &Body, bi: u32, g: Vec2) -> BodySim {
     }
 }
 
-/// What one chunk of the narrow phase found, in contact order: the touching contacts,
-/// those the solver takes, and those to destroy or whose touching changed (events). The
+/// What one chunk of the narrow phase found, in contact order: the touching contacts the
+/// solver takes, those it does not, and those to destroy or whose touching changed
+/// (events). The
 /// serial pass after the narrow phase joins the chunks' lists instead of reading every
 /// contact's verdict (a serial 30-40 µs of large_pyramid's two-thread step).
 #[derive(Debug, Default)]
 pub(crate) struct ChunkOutcomes {
-    touching: Vec<u32>,
     solvable: Vec<u32>,
+    /// Touching, not taken by the solver (no awake dynamic side).
+    unsolved: Vec<u32>,
     special: Vec<(u32, NarrowOutcome)>,
 }
 
 impl ChunkOutcomes {
     fn clear(&mut self) {
-        self.touching.clear();
         self.solvable.clear();
+        self.unsolved.clear();
         self.special.clear();
     }
 
@@ -1076,9 +1091,10 @@ impl ChunkOutcomes {
             NarrowOutcome::Destroy => self.special.push((ci, outcome)),
             NarrowOutcome::Updated { touching, changed } => {
                 if touching {
-                    self.touching.push(ci);
                     if solvable {
                         self.solvable.push(ci);
+                    } else {
+                        self.unsolved.push(ci);
                     }
                 }
                 if changed {
