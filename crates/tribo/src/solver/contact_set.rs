@@ -272,6 +272,9 @@ pub(crate) struct ContactSolver {
     /// Counts the layouts made ([`ContactSolver::colour_and_lay_out`]): while it stands
     /// still, each step's solved order ([`ContactSolver::solved_order`]) is last step's.
     pub(crate) layouts: u64,
+    /// The team's cuts ([`ContactSolver::team_cuts`]) for (layout, threads, bodies): a kept
+    /// layout keeps its groups' bodies, so its cuts too.
+    cuts_cache: Option<((u64, usize, usize), Vec<Vec<Vec<usize>>>)>,
     // Scratch reused every step.
     /// Each candidate's colour (with the [`FAST`] and [`FRESH`] flags) or [`OVERFLOW`].
     colours: Vec<u8>,
@@ -1240,8 +1243,9 @@ impl ContactSolver {
     /// ended at different bodies, and about 15 000 cache lines of states crossed between the
     /// two cores per large_pyramid step. Where a part is not in body order the cuts are only
     /// worse, never wrong: every block is still solved once per pass.
-    fn team_blocks(&mut self, threads: usize, per_thread: usize) -> Vec<Vec<TeamPart<GroupBlock<'_>>>> {
-        // Group boundaries, in order: per colour, per part, per thread.
+    /// [`ContactSolver::team_blocks`]' group boundaries: per colour, per part, the groups
+    /// where each thread's share starts, then the part's end.
+    fn team_cuts(&self, threads: usize, per_thread: usize) -> Vec<Vec<Vec<usize>>> {
         let owner_key = |h: &WideHead| {
             let (a, b) = (h.index_a[0], h.index_b[0]);
             (if a == 0 || (b != 0 && b < a) { b } else { a }) as usize
@@ -1253,7 +1257,7 @@ impl ContactSolver {
                 if a >= b {
                     continue;
                 }
-                let heads = &self.head[a..b];
+                let heads = self.head.get(a..b).unwrap_or(&[]);
                 let mut at = vec![a];
                 for k in 1..threads {
                     let cut = a + heads.partition_point(|h| owner_key(h) < k * per_thread);
@@ -1264,6 +1268,20 @@ impl ContactSolver {
             }
             cuts.push(parts);
         }
+        cuts
+    }
+
+    fn team_blocks(&mut self, threads: usize, per_thread: usize) -> Vec<Vec<TeamPart<GroupBlock<'_>>>> {
+        // Group boundaries, in order: per colour, per part, per thread. Found by binary
+        // searches over the groups' first lanes, lines the build has just written on
+        // either thread (a serial 10 µs of large_pyramid's two-thread step), so kept with
+        // the layout they were found for.
+        let id = (self.layouts, threads, per_thread);
+        let cuts = match self.cuts_cache.take() {
+            Some((at, cuts)) if at == id => cuts,
+            _ => self.team_cuts(threads, per_thread),
+        };
+        self.cuts_cache = Some((id, cuts.clone()));
         let (mut heads, mut wides): (&mut [WideHead], &mut [WideContact]) = (&mut self.head, &mut self.wide);
         let mut taken = 0usize;
         let mut colours = Vec::with_capacity(cuts.len());
