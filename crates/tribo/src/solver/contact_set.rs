@@ -272,8 +272,8 @@ pub(crate) struct ContactSolver {
     /// Counts the layouts made ([`ContactSolver::colour_and_lay_out`]): while it stands
     /// still, each step's solved order ([`ContactSolver::solved_order`]) is last step's.
     pub(crate) layouts: u64,
-    /// The team's cuts ([`ContactSolver::team_cuts`]) for (layout, threads, bodies): a kept
-    /// layout keeps its groups' bodies, so its cuts too.
+    /// The team's cuts ([`ContactSolver::team_cuts`]) for (layout, threads, bodies per
+    /// thread): a kept layout keeps its groups' bodies, so its cuts too.
     cuts_cache: Option<((u64, usize, usize), Vec<Vec<Vec<usize>>>)>,
     // Scratch reused every step.
     /// Each candidate's colour (with the [`FAST`] and [`FRESH`] flags) or [`OVERFLOW`].
