@@ -274,7 +274,7 @@ pub(crate) struct ContactSolver {
     pub(crate) layouts: u64,
     /// The team's cuts ([`ContactSolver::team_cuts`]) for (layout, threads, bodies per
     /// thread): a kept layout keeps its groups' bodies, so its cuts too.
-    cuts_cache: Option<((u64, usize, usize), Vec<Vec<Vec<usize>>>)>,
+    cuts_cache: Option<((u64, usize, usize), TeamCuts)>,
     // Scratch reused every step.
     /// Each candidate's colour (with the [`FAST`] and [`FRESH`] flags) or [`OVERFLOW`].
     colours: Vec<u8>,
@@ -325,6 +325,10 @@ impl<T> TeamBlock<T> {
         self.claimed.fetch_max(stamp, core::sync::atomic::Ordering::AcqRel) < stamp
     }
 }
+
+/// The substep team's group boundaries: per colour, per part, the groups where each
+/// thread's share starts, then the part's end (`ContactSolver::team_cuts`).
+type TeamCuts = Vec<Vec<Vec<usize>>>;
 
 /// A colour's block: its groups (the mutex only hands the claiming thread its `&mut`; it
 /// is never contended).
@@ -738,8 +742,9 @@ impl ContactSolver {
         let same = if parallel && n >= 2 * LAYOUT_CHUNK {
             // In chunks on the pool's threads (a serial 23-29 µs of large_pyramid's
             // two-thread step, 160 µs of many_pyramids'), the light bodies in order.
-            let parts: Vec<std::sync::Mutex<(bool, Vec<(u32, u32)>)>> =
-                (0..n.div_ceil(LAYOUT_CHUNK)).map(|_| Default::default()).collect();
+            // Per chunk: whether it is as last step, its light bodies.
+            type Part = std::sync::Mutex<(bool, Vec<(u32, u32)>)>;
+            let parts: Vec<Part> = (0..n.div_ceil(LAYOUT_CHUNK)).map(|_| Default::default()).collect();
             claim_each(true, 0..parts.len(), |k| {
                 if let Some(part) = parts.get(k) {
                     let mut part = part.lock().unwrap_or_else(|e| e.into_inner());
@@ -1245,12 +1250,12 @@ impl ContactSolver {
     /// worse, never wrong: every block is still solved once per pass.
     /// [`ContactSolver::team_blocks`]' group boundaries: per colour, per part, the groups
     /// where each thread's share starts, then the part's end.
-    fn team_cuts(&self, threads: usize, per_thread: usize) -> Vec<Vec<Vec<usize>>> {
+    fn team_cuts(&self, threads: usize, per_thread: usize) -> TeamCuts {
         let owner_key = |h: &WideHead| {
             let (a, b) = (h.index_a[0], h.index_b[0]);
             (if a == 0 || (b != 0 && b < a) { b } else { a }) as usize
         };
-        let mut cuts: Vec<Vec<Vec<usize>>> = Vec::with_capacity(self.ranges.len());
+        let mut cuts: TeamCuts = Vec::with_capacity(self.ranges.len());
         for (&(start, end), &slow) in self.ranges.iter().zip(&self.slow_start) {
             let mut parts = Vec::with_capacity(2);
             for (a, b) in [(start as usize, slow as usize), (slow as usize, end as usize)] {
