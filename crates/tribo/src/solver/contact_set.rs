@@ -1286,11 +1286,10 @@ impl ContactSolver {
             Some((at, cuts)) if at == id => cuts,
             _ => self.team_cuts(threads, per_thread),
         };
-        self.cuts_cache = Some((id, cuts.clone()));
         let (mut heads, mut wides): (&mut [WideHead], &mut [WideContact]) = (&mut self.head, &mut self.wide);
         let mut taken = 0usize;
         let mut colours = Vec::with_capacity(cuts.len());
-        for parts in cuts {
+        for parts in &cuts {
             let mut out = Vec::with_capacity(parts.len());
             for at in parts {
                 let (_, h_rest) = core::mem::take(&mut heads).split_at_mut(at[0] - taken);
@@ -1315,6 +1314,7 @@ impl ContactSolver {
             }
             colours.push(out);
         }
+        self.cuts_cache = Some((id, cuts));
         colours
     }
 

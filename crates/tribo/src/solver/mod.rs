@@ -531,9 +531,10 @@ pub(crate) struct StepContext {
 /// project's VM a sleeping worker starts a job spawned for it about 20 µs late (measured:
 /// 1 400 spawns, seven parallel stages a step), while the spawning thread starts at once.
 /// So during a step, after each parallel stage, the other threads are given a job that
-/// spins (`hold`) until the next stage is posted (`release`; every spawning site runs
-/// its scope through [`awake::stage`], which does both) or a millisecond has passed, as Box2D v3's workers spin between its
-/// stages. The spinner changes nothing but who waits: results do not depend on it.
+/// spins (`hold`) until the next stage is posted (`release`; every spawning site runs its
+/// scope through [`awake::stage`], which does both) or a millisecond has passed, as Box2D
+/// v3's workers spin between its stages. The spinner changes nothing but who waits:
+/// results do not depend on it.
 pub(crate) mod awake {
     use core::sync::atomic::{AtomicU64, Ordering};
     use std::cell::RefCell;
