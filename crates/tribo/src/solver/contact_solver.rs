@@ -1084,7 +1084,9 @@ pub(crate) fn solve_one<S: StateCell>(
         b.touched = 1.0;
     }
     solve_friction(cc, &mut a, &mut b, ctx, use_bias, elapsed);
-    if cc.rolling_resistance > 0.0 && !use_bias {
+    // A rolling impulse left without resistance (none can arise from a scene today) is
+    // relaxed to zero, as the wide solver's lanes do, not warm-started every substep.
+    if (cc.rolling_resistance > 0.0 || cc.rolling_impulse != 0.0) && !use_bias {
         solve_rolling(cc, &mut a, &mut b);
     }
     store(states, cc.index_a, cc.index_b, a, b);
