@@ -496,6 +496,121 @@ fn kinetic_energy(h: &WideHead, a: &WideBody, b: &WideBody) -> F4 {
     part(h.inv_mass_a, h.inv_i_a, a) + part(h.inv_mass_b, h.inv_i_b, b)
 }
 
+/// The normal rows of one pass over four constraints (contact_solver::normal_row): bias
+/// and softness per point, then the 2×2 block or the points in turn; returns the points'
+/// new impulses. `POINTS` = 1 for a group with no second point in any lane (see
+/// `contact_set::SINGLE`): only the first point's row, what the general path computes for
+/// such lanes (the sequential row), with the second point's impulse +0 (its mass, impulse
+/// and preload are zero, so that row gives +0). A constant, so each form's loops unroll.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
+    h: &mut WideHead,
+    c: &mut WideContact,
+    a: &mut WideBody,
+    b: &mut WideBody,
+    d: V4,
+    shift: V4,
+    ctx: &StepContext,
+    (bias_rate, mass_scale, impulse_scale): (F4, F4, F4),
+) -> (F4, F4) {
+    let n = h.normal;
+    let zero = F4::ZERO;
+    let one = F4::splat(1.0);
+    let push = F4::splat(ctx.push_speed);
+    let mut arms = [(V4::default(), V4::default()); 2];
+    let mut vn = [zero; 2];
+    let mut bias = [zero; 2];
+    let mut ms = [zero; 2];
+    let mut is = [zero; 2];
+    for i in 0..POINTS {
+        let (hp, p) = (&h.points[i], &c.points[i]);
+        arms[i] = lever_arms(h, shift, hp.r_a, hp.r_b);
+        let s = anchor_displacement(a, b, d, hp.r_a, hp.r_b).dot(n) + p.base_separation;
+        let speculative = s.gt(zero);
+        let (soft_bias, soft_ms, soft_is) = if USE_BIAS {
+            ((bias_rate * s).max(-push), mass_scale, impulse_scale)
+        } else {
+            (zero, one, zero)
+        };
+        bias[i] = speculative.select(s * F4::splat(ctx.inv_h), soft_bias);
+        ms[i] = speculative.select(one, soft_ms);
+        is[i] = speculative.select(zero, soft_is);
+        vn[i] = relative_velocity(a, b, arms[i].0, arms[i].1).dot(n);
+    }
+    let [p0, p1] = &c.points;
+    let (lam0, lam1) = (h.points[0].normal_impulse, h.points[1].normal_impulse);
+    let (pre0, pre1) = (p0.preload, p1.preload);
+    let rhs0 = vn[0] + bias[0];
+    let (new0, new1) = if POINTS == 1 {
+        // The sequential row of the first point (the general path's `seq0`).
+        let seq0 = (lam0 + (-(p0.normal_mass * ms[0] * rhs0) - is[0] * (lam0 - pre0))).max(zero);
+        apply(h, a, b, arms[0].0, arms[0].1, n.scale(seq0 - lam0));
+        (seq0, zero)
+    } else {
+        // The 2×2 block LCP (contact_solver::solve_block), all four cases in every lane.
+        let rhs1 = vn[1] + bias[1];
+        let soft0 = |rd: F4| lam0 + ms[0] * rd - is[0] * (lam0 - pre0);
+        let soft1 = |rd: F4| lam1 + ms[1] * rd - is[1] * (lam1 - pre1);
+        // K⁻¹ = [k22, −k12; −k12, k11] / det K (zero where the block does not apply).
+        let (i11, i12, i22) = (c.k22 * c.inv_det, -c.k12 * c.inv_det, c.k11 * c.inv_det);
+        let xa0 = soft0(-(i11 * rhs0 + i12 * rhs1));
+        let xa1 = soft1(-(i12 * rhs0 + i22 * rhs1));
+        let ok_a = xa0.ge(zero) & xa1.ge(zero);
+        if (ok_a & c.block).all() {
+            // Common case (a resting face): both points active in every lane.
+            apply(h, a, b, arms[0].0, arms[0].1, n.scale(xa0 - lam0));
+            apply(h, a, b, arms[1].0, arms[1].1, n.scale(xa1 - lam1));
+            (xa0, xa1)
+        } else {
+            let r0 = rhs0 - c.k12 * lam1;
+            // 1/k11 and 1/k22: the points' normal masses (where the block applies).
+            let xb0 = soft0(-(r0 * p0.normal_mass));
+            let wb1 = rhs1 + c.k12 * (xb0 - lam0) - c.k22 * lam1;
+            let ok_b = xb0.ge(zero) & wb1.ge(zero);
+            let r1 = rhs1 - c.k12 * lam0;
+            let xc1 = soft1(-(r1 * p1.normal_mass));
+            let wc0 = rhs0 + c.k12 * (xc1 - lam1) - c.k11 * lam0;
+            let ok_c = xc1.ge(zero) & wc0.ge(zero);
+            let wd0 = rhs0 - c.k11 * lam0 - c.k12 * lam1;
+            let wd1 = rhs1 - c.k12 * lam0 - c.k22 * lam1;
+            let ok_d = wd0.ge(zero) & wd1.ge(zero);
+            let block0 = ok_a.select(xa0, ok_b.select(xb0, zero));
+            let block1 = ok_a.select(xa1, (!ok_b & ok_c).select(xc1, zero));
+            let found = c.block & (ok_a | ok_b | ok_c | ok_d);
+            if found.all() {
+                // Every lane solved as a block: no sequential rows needed.
+                apply(h, a, b, arms[0].0, arms[0].1, n.scale(block0 - lam0));
+                apply(h, a, b, arms[1].0, arms[1].1, n.scale(block1 - lam1));
+                (block0, block1)
+            } else {
+                // Sequential rows where the block solve does not apply.
+                let seq0 = (lam0 + (-(p0.normal_mass * ms[0] * rhs0) - is[0] * (lam0 - pre0))).max(zero);
+                let new0 = found.select(block0, seq0);
+                apply(h, a, b, arms[0].0, arms[0].1, n.scale(new0 - lam0));
+                let vn1 = relative_velocity(a, b, arms[1].0, arms[1].1).dot(n);
+                let seq1 = (lam1 + (-(p1.normal_mass * ms[1] * (vn1 + bias[1])) - is[1] * (lam1 - pre1))).max(zero);
+                let new1 = found.select(block1, seq1);
+                apply(h, a, b, arms[1].0, arms[1].1, n.scale(new1 - lam1));
+                (new0, new1)
+            }
+        }
+    };
+    for ((p, hp), new) in c
+        .points
+        .iter_mut()
+        .zip(h.points.iter_mut())
+        .zip([new0, new1])
+        .take(POINTS)
+    {
+        hp.normal_impulse = new;
+        p.max_normal_impulse = p.max_normal_impulse.max(new);
+        let lower = new.gt(zero) & hp.substep_vn.lt(p.approach);
+        p.approach = lower.select(hp.substep_vn, p.approach);
+    }
+    (new0, new1)
+}
+
 /// One pass over four constraints: normal rows (block or sequential), the friction row,
 /// rolling resistance in the relax pass.
 pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
@@ -520,105 +635,13 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
         (zero, one, zero)
     };
 
-    // Normal rows: bias and softness per point (contact_solver::normal_row). In the biased
-    // pass, a group with no second point in any lane (see `contact_set::SINGLE`) solves only
-    // the first: what the general path below computes for its lanes, with the second
-    // point's impulse +0 (its mass, impulse and preload are zero, so the sequential row
-    // gives +0 for it). Tumbler's biased pass went from 0.309 to 0.266 ms; the same path
-    // in the relax pass made that pass slower (0.274 to 0.305 ms), so the relax keeps the
-    // general path.
-    let single = USE_BIAS && !h.two_points.any();
-    let points = if single { 1 } else { 2 };
-    let mut arms = [(V4::default(), V4::default()); 2];
-    let mut vn = [zero; 2];
-    let mut bias = [zero; 2];
-    let mut ms = [zero; 2];
-    let mut is = [zero; 2];
-    for i in 0..points {
-        let (hp, p) = (&h.points[i], &c.points[i]);
-        arms[i] = lever_arms(h, shift, hp.r_a, hp.r_b);
-        let s = anchor_displacement(&a, &b, d, hp.r_a, hp.r_b).dot(n) + p.base_separation;
-        let speculative = s.gt(zero);
-        let (soft_bias, soft_ms, soft_is) = if USE_BIAS {
-            ((bias_rate * s).max(-push), mass_scale, impulse_scale)
-        } else {
-            (zero, one, zero)
-        };
-        bias[i] = speculative.select(s * F4::splat(ctx.inv_h), soft_bias);
-        ms[i] = speculative.select(one, soft_ms);
-        is[i] = speculative.select(zero, soft_is);
-        vn[i] = relative_velocity(&a, &b, arms[i].0, arms[i].1).dot(n);
-    }
-    let [p0, p1] = &c.points;
-    let (lam0, lam1) = (h.points[0].normal_impulse, h.points[1].normal_impulse);
-    let (pre0, pre1) = (p0.preload, p1.preload);
-    let rhs0 = vn[0] + bias[0];
-    let (new0, new1) = if single {
-        // The sequential row of the first point (the general path's `seq0`).
-        let seq0 = (lam0 + (-(p0.normal_mass * ms[0] * rhs0) - is[0] * (lam0 - pre0))).max(zero);
-        apply(h, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(seq0 - lam0));
-        (seq0, zero)
+    // Normal rows; groups of single points skip the second point and the block.
+    let rows = (bias_rate, mass_scale, impulse_scale);
+    let (new0, new1) = if h.two_points.any() {
+        normal_rows::<USE_BIAS, 2>(h, c, &mut a, &mut b, d, shift, ctx, rows)
     } else {
-        // The 2×2 block LCP (contact_solver::solve_block), all four cases in every lane.
-        let rhs1 = vn[1] + bias[1];
-        let soft0 = |rd: F4| lam0 + ms[0] * rd - is[0] * (lam0 - pre0);
-        let soft1 = |rd: F4| lam1 + ms[1] * rd - is[1] * (lam1 - pre1);
-        // K⁻¹ = [k22, −k12; −k12, k11] / det K (zero where the block does not apply).
-        let (i11, i12, i22) = (c.k22 * c.inv_det, -c.k12 * c.inv_det, c.k11 * c.inv_det);
-        let xa0 = soft0(-(i11 * rhs0 + i12 * rhs1));
-        let xa1 = soft1(-(i12 * rhs0 + i22 * rhs1));
-        let ok_a = xa0.ge(zero) & xa1.ge(zero);
-        if (ok_a & c.block).all() {
-            // Common case (a resting face): both points active in every lane.
-            apply(h, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(xa0 - lam0));
-            apply(h, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(xa1 - lam1));
-            (xa0, xa1)
-        } else {
-            let r0 = rhs0 - c.k12 * lam1;
-            // 1/k11 and 1/k22: the points' normal masses (where the block applies).
-            let xb0 = soft0(-(r0 * p0.normal_mass));
-            let wb1 = rhs1 + c.k12 * (xb0 - lam0) - c.k22 * lam1;
-            let ok_b = xb0.ge(zero) & wb1.ge(zero);
-            let r1 = rhs1 - c.k12 * lam0;
-            let xc1 = soft1(-(r1 * p1.normal_mass));
-            let wc0 = rhs0 + c.k12 * (xc1 - lam1) - c.k11 * lam0;
-            let ok_c = xc1.ge(zero) & wc0.ge(zero);
-            let wd0 = rhs0 - c.k11 * lam0 - c.k12 * lam1;
-            let wd1 = rhs1 - c.k12 * lam0 - c.k22 * lam1;
-            let ok_d = wd0.ge(zero) & wd1.ge(zero);
-            let block0 = ok_a.select(xa0, ok_b.select(xb0, zero));
-            let block1 = ok_a.select(xa1, (!ok_b & ok_c).select(xc1, zero));
-            let found = c.block & (ok_a | ok_b | ok_c | ok_d);
-            if found.all() {
-                // Every lane solved as a block: no sequential rows needed.
-                apply(h, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(block0 - lam0));
-                apply(h, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(block1 - lam1));
-                (block0, block1)
-            } else {
-                // Sequential rows where the block solve does not apply.
-                let seq0 = (lam0 + (-(p0.normal_mass * ms[0] * rhs0) - is[0] * (lam0 - pre0))).max(zero);
-                let new0 = found.select(block0, seq0);
-                apply(h, &mut a, &mut b, arms[0].0, arms[0].1, n.scale(new0 - lam0));
-                let vn1 = relative_velocity(&a, &b, arms[1].0, arms[1].1).dot(n);
-                let seq1 = (lam1 + (-(p1.normal_mass * ms[1] * (vn1 + bias[1])) - is[1] * (lam1 - pre1))).max(zero);
-                let new1 = found.select(block1, seq1);
-                apply(h, &mut a, &mut b, arms[1].0, arms[1].1, n.scale(new1 - lam1));
-                (new0, new1)
-            }
-        }
+        normal_rows::<USE_BIAS, 1>(h, c, &mut a, &mut b, d, shift, ctx, rows)
     };
-    for ((p, hp), new) in c
-        .points
-        .iter_mut()
-        .zip(h.points.iter_mut())
-        .zip([new0, new1])
-        .take(points)
-    {
-        hp.normal_impulse = new;
-        p.max_normal_impulse = p.max_normal_impulse.max(new);
-        let lower = new.gt(zero) & hp.substep_vn.lt(p.approach);
-        p.approach = lower.select(hp.substep_vn, p.approach);
-    }
     let pushed = (new0.gt(zero) | new1.gt(zero)).to_unit();
     a.touched = a.touched.max(pushed);
     b.touched = b.touched.max(pushed);
