@@ -1264,6 +1264,18 @@ mod tests {
         }
     }
 
+    /// A body state with velocity (vx, vy) [m/s], ω = `w` [rad/s], moved by `dp` [m] and
+    /// turned by `angle` [rad] so far in the step.
+    fn moved_state(vx: f32, vy: f32, w: f32, dp: Vec2, angle: f32) -> BodyState {
+        BodyState {
+            v: Vec2::new(vx, vy),
+            w,
+            touched: 0.0,
+            dp,
+            dq: Rot::from_angle(angle),
+        }
+    }
+
     fn bodies(index_a: u32, index_b: u32) -> ConstraintBodies {
         let side = |i: u32, m: f32| if i == 0 { (0.0, 0.0) } else { (1.0 / m, 6.0 / m) };
         let ((inv_mass_a, inv_i_a), (inv_mass_b, inv_i_b)) = (side(index_a, 2.0), side(index_b, 0.5));
@@ -1391,13 +1403,7 @@ mod tests {
     fn one_point_solve_equals_scalar_solve() {
         let ctx = StepContext::for_tests();
         let soft = StepSoftness::new(&ctx);
-        let state = |vx: f32, vy: f32, w: f32| BodyState {
-            v: Vec2::new(vx, vy),
-            w,
-            touched: 0.0,
-            dp: Vec2::new(1e-3 * vx, -2e-3),
-            dq: Rot::from_angle(1e-3 * w),
-        };
+        let state = |vx: f32, vy: f32, w: f32| moved_state(vx, vy, w, Vec2::new(1e-3 * vx, -2e-3), 1e-3 * w);
         let states = vec![
             BodyState::default(),
             state(0.4, -0.5, 1.5),
@@ -1503,13 +1509,7 @@ mod tests {
     fn wide_restitution_equals_scalar_restitution() {
         let ctx = StepContext::for_tests();
         let soft = StepSoftness::new(&ctx);
-        let state = |vx: f32, vy: f32, w: f32| BodyState {
-            v: Vec2::new(vx, vy),
-            w,
-            touched: 0.0,
-            dp: Vec2::new(1e-3, -2e-3),
-            dq: Rot::from_angle(1e-3),
-        };
+        let state = |vx: f32, vy: f32, w: f32| moved_state(vx, vy, w, Vec2::new(1e-3, -2e-3), 1e-3);
         let states = vec![
             BodyState::default(),
             state(0.4, 2.5, 1.5),
