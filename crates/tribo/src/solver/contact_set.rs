@@ -481,9 +481,9 @@ const _: () = assert!((COLORS as u8 - 1) | FAST | FRESH | SINGLE != OVERFLOW);
 /// Whether a constraint goes to the front of its colour: a face contact whose two points
 /// both carried load last step, which will most likely keep both points pushing and take
 /// the wide solver's fast path (the 2×2 block with both points active). The others —
-/// single points, faces touching on one corner, speculative pairs not yet touching — go to
-/// the back, so the fast path is not lost to a whole group of four because one lane needs
-/// the general case. Constraints of one colour share no moving body, so their order inside
+/// faces touching on one corner, speculative pairs not yet touching, and behind those the
+/// single points ([`SINGLE`]) — go to the back, so the fast path is not lost to a whole
+/// group of four because one lane needs the general case. Constraints of one colour share no moving body, so their order inside
 /// the colour does not change any result.
 #[inline]
 fn fast_first(input: &ContactInput) -> bool {
