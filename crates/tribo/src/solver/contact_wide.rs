@@ -629,14 +629,15 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     let zero = F4::ZERO;
     let one = F4::splat(1.0);
     let push = F4::splat(ctx.push_speed);
-    let (bias_rate, mass_scale, impulse_scale) = if USE_BIAS {
+    // (bias rate, mass scale, impulse scale); the friction row's bias reads the rate.
+    let rows = if USE_BIAS {
         lane_softness(h, soft)
     } else {
         (zero, one, zero)
     };
+    let bias_rate = rows.0;
 
     // Normal rows; groups of single points skip the second point and the block.
-    let rows = (bias_rate, mass_scale, impulse_scale);
     let (new0, new1) = if h.two_points.any() {
         normal_rows::<USE_BIAS, 2>(h, c, &mut a, &mut b, d, shift, ctx, rows)
     } else {

@@ -1065,9 +1065,8 @@ fn body_sim(b: &Body, bi: u32, g: Vec2) -> BodySim {
 
 /// What one chunk of the narrow phase found, in contact order: the touching contacts the
 /// solver takes, those it does not, and those to destroy or whose touching changed
-/// (events). The
-/// serial pass after the narrow phase joins the chunks' lists instead of reading every
-/// contact's verdict (a serial 30-40 µs of large_pyramid's two-thread step).
+/// (events). The serial pass after the narrow phase joins the chunks' lists instead of
+/// reading every contact's verdict (a serial 30-40 µs of large_pyramid's two-thread step).
 #[derive(Debug, Default)]
 pub(crate) struct ChunkOutcomes {
     solvable: Vec<u32>,
