@@ -229,6 +229,11 @@ pub struct World {
     pub(crate) scratch_fitted: Vec<core::sync::atomic::AtomicBool>,
     /// Per solver slot: touched something this step (`finalize`'s sweep rule).
     pub(crate) scratch_touched: Vec<bool>,
+    /// Solved bodies per chunk of body slots in the last parallel body pass (its guess
+    /// for this step; see `World::prepare_bodies_parallel`).
+    pub(crate) scratch_chunk_counts: Vec<usize>,
+    /// Parallel body passes run again because a chunk's count changed (for tests).
+    pub(crate) body_pass_retries: u64,
     /// Static shapes found by the continuous check (`stop_at_static_shapes`).
     pub(crate) scratch_found: Vec<u32>,
     /// Per body slot, what the solver's constraints need of it (rebuilt every step).
@@ -295,6 +300,8 @@ impl World {
             mostly_awake: false,
             scratch_fitted: Vec::new(),
             scratch_touched: Vec::new(),
+            scratch_chunk_counts: Vec::new(),
+            body_pass_retries: 0,
             scratch_found: Vec::new(),
             solver_bodies: Vec::new(),
             step_count: 0,
@@ -1379,6 +1386,62 @@ mod tests {
         for ((_, x), (_, y)) in a.bodies.iter().zip(b.bodies.iter()) {
             assert_eq!((x.xf, x.v, x.w), (y.xf, y.v, y.w));
         }
+    }
+
+    /// The parallel body pass (`World::prepare_bodies_parallel`) guesses each chunk's
+    /// solved bodies from the last step and runs again when a count changed. Bodies that
+    /// fall asleep, wake, come and go change the counts; the two-worker world must stay
+    /// bit for bit the one-worker world in every step, and the pass must have run again
+    /// (else the test proves nothing about the retry).
+    #[test]
+    fn the_parallel_body_pass_follows_sleep_and_new_bodies() {
+        let cube = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
+        let make = |workers: u32| {
+            let mut w = World::new(WorldDef {
+                workers,
+                ..WorldDef::default()
+            })
+            .unwrap();
+            let ground = w.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
+            let slab = Shape::Polygon(Polygon::new_box(400.0, 1.0).unwrap());
+            w.create_shape(ground, &ShapeDef::default(), &slab).unwrap();
+            // 30 columns of 12 boxes, 2 m apart: 360 bodies in two chunks of slots.
+            let mut ids = Vec::new();
+            for col in 0..30 {
+                for row in 0..12 {
+                    let at = Vec2::new(2.0 * col as f32 - 30.0, 0.5 + row as f32);
+                    let b = w.create_body(&BodyDef::dynamic(at)).unwrap();
+                    w.create_shape(b, &ShapeDef::default(), &cube).unwrap();
+                    ids.push(b);
+                }
+            }
+            (w, ids)
+        };
+        let ((mut a, ids_a), (mut b, ids_b)) = (make(1), make(2));
+        let awake = |w: &World| w.bodies.iter().filter(|(_, x)| x.awake && x.is_dynamic()).count();
+        let mut fewest = usize::MAX;
+        for step in 0..240 {
+            // A column's top box goes at step 120 (its neighbours below wake); a new box
+            // drops onto another column at step 160.
+            if step == 120 {
+                a.destroy_body(ids_a[11]).unwrap();
+                b.destroy_body(ids_b[11]).unwrap();
+            }
+            if step == 160 {
+                for w in [&mut a, &mut b] {
+                    let n = w.create_body(&BodyDef::dynamic(Vec2::new(-20.0, 14.0))).unwrap();
+                    w.create_shape(n, &ShapeDef::default(), &cube).unwrap();
+                }
+            }
+            a.step(1.0 / 60.0).unwrap();
+            b.step(1.0 / 60.0).unwrap();
+            fewest = fewest.min(awake(&b));
+            for ((_, x), (_, y)) in a.bodies.iter().zip(b.bodies.iter()) {
+                assert_eq!((x.xf, x.v, x.w, x.awake), (y.xf, y.v, y.w, y.awake), "step {step}");
+            }
+        }
+        assert!(fewest < 360, "some bodies fell asleep (fewest awake: {fewest})");
+        assert!(b.body_pass_retries >= 2, "retries: {}", b.body_pass_retries);
     }
 
     /// A shower of spinning boxes thrown down onto a slab between two walls (sleep off).

@@ -17,8 +17,8 @@ use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::{Candidate, Candidates, ColourKey};
 use crate::solver::{
-    claim_each, for_each_chunk_mut4, for_each_mut, loads, solve_step, BodySim, BodyState, SharedState, SolverBody,
-    StepConstraints, StepContext,
+    claim_each, for_each_chunk_mut4, loads, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints,
+    StepContext,
 };
 use crate::world::Arena;
 use crate::world::{box_velocity, next_box};
@@ -632,20 +632,38 @@ impl World {
         self.mostly_awake = 2 * (self.states.len() - 1) > self.bodies.len();
     }
 
-    /// [`World::prepare_bodies`] on the pool's threads, with the same result: the solved
-    /// bodies of each chunk of [`BODY_CHUNK`] slots are counted first, so each chunk knows
-    /// where its states start (solver order stays slot order); then every chunk writes its
-    /// entries, states and step data. Done serially this pass was a tenth of
-    /// large_pyramid's two-thread set-up.
+    /// [`World::prepare_bodies`] on the pool's threads, with the same result: each chunk
+    /// of [`BODY_CHUNK`] slots writes its solved bodies' entries, states and step data from
+    /// the solver index where the chunks before it end (solver order stays slot order).
+    /// Those ends come from the chunks' solved counts of the last step, checked as the
+    /// chunks go: when a body woke, slept, came or went and a count changed, the pass runs
+    /// again with the counts it found (what a chunk finds does not depend on the guess, so
+    /// the second run is the last). Done serially this pass was a tenth of
+    /// large_pyramid's two-thread set-up; with a counting pass of its own first (a read of
+    /// every body record) it took as long on two threads as on one (60 µs).
     fn prepare_bodies_parallel(&mut self, g: Vec2) {
+        let chunks = self.solver_bodies.len().div_ceil(BODY_CHUNK);
+        let mut counts = core::mem::take(&mut self.scratch_chunk_counts);
+        if counts.len() != chunks {
+            counts.clear();
+            counts.resize(chunks, BODY_CHUNK);
+        }
+        loop {
+            let found = self.prepare_chunks(g, &counts);
+            if found == counts {
+                break;
+            }
+            self.body_pass_retries += 1;
+            counts = found;
+        }
+        self.scratch_chunk_counts = counts;
+    }
+
+    /// One try of [`World::prepare_bodies_parallel`] with `counts[c]` solved bodies
+    /// assumed in chunk `c`; returns the counts found. Every entry is written; the states
+    /// and step data are right when the counts found are the ones assumed.
+    fn prepare_chunks(&mut self, g: Vec2, counts: &[usize]) -> Vec<usize> {
         let bodies = &self.bodies;
-        let capacity = self.solver_bodies.len();
-        let mut counts = vec![0usize; capacity.div_ceil(BODY_CHUNK)];
-        for_each_mut(true, &mut counts, 1, |c, count| {
-            *count = (c * BODY_CHUNK..((c + 1) * BODY_CHUNK).min(capacity))
-                .filter(|&bi| bodies.at(bi as u32).is_some_and(solved))
-                .count();
-        });
         let total: usize = counts.iter().sum();
         // Every entry past index 0 (every static body) is written below, so last step's
         // are kept and only the length changes: cleared and refilled, these arrays took a
@@ -658,37 +676,45 @@ impl World {
         // Each chunk's share of the states and step data, and its first solver index.
         let mut shares = Vec::with_capacity(counts.len());
         let (mut states, mut sims, mut first) = (&mut self.states[1..], &mut self.sims[1..], 1usize);
-        for &n in &counts {
+        for &n in counts {
             let (st, st_rest) = core::mem::take(&mut states).split_at_mut(n);
             let (si, si_rest) = core::mem::take(&mut sims).split_at_mut(n);
             shares.push((first, st, si));
             (states, sims, first) = (st_rest, si_rest, first + n);
         }
+        let mut found = vec![0usize; counts.len()];
         let chunks = self
             .solver_bodies
             .chunks_mut(BODY_CHUNK)
             .zip(self.scratch_flags.chunks_mut(BODY_CHUNK))
             .zip(shares)
+            .zip(found.iter_mut())
             .enumerate();
         let loaded = core::sync::atomic::AtomicBool::new(false);
-        claim_each(true, chunks, |(c, ((entries, flags), (first, states, sims)))| {
-            let (mut next, mut any) = (0usize, false);
-            for (k, (sb, flag)) in entries.iter_mut().zip(flags.iter_mut()).enumerate() {
-                let bi = c * BODY_CHUNK + k;
-                if let Some(b) = prepare_slot(bodies.at(bi as u32), (first + next) as u32, sb, flag) {
-                    if let (Some(state), Some(sim)) = (states.get_mut(next), sims.get_mut(next)) {
-                        *state = body_state(b);
-                        *sim = body_sim(b, bi as u32, g);
-                        any |= loads(sim);
+        claim_each(
+            true,
+            chunks,
+            |(c, (((entries, flags), (first, states, sims)), found))| {
+                let (mut next, mut any) = (0usize, false);
+                for (k, (sb, flag)) in entries.iter_mut().zip(flags.iter_mut()).enumerate() {
+                    let bi = c * BODY_CHUNK + k;
+                    if let Some(b) = prepare_slot(bodies.at(bi as u32), (first + next) as u32, sb, flag) {
+                        if let (Some(state), Some(sim)) = (states.get_mut(next), sims.get_mut(next)) {
+                            *state = body_state(b);
+                            *sim = body_sim(b, bi as u32, g);
+                            any |= loads(sim);
+                        }
+                        next += 1;
                     }
-                    next += 1;
                 }
-            }
-            if any {
-                loaded.store(true, core::sync::atomic::Ordering::Relaxed);
-            }
-        });
+                *found = next;
+                if any {
+                    loaded.store(true, core::sync::atomic::Ordering::Relaxed);
+                }
+            },
+        );
         self.any_load = loaded.into_inner();
+        found
     }
 
     /// Builds the solver's constraints from the candidates the narrow phase made, runs the
