@@ -1421,8 +1421,9 @@ mod tests {
         let awake = |w: &World| w.bodies.iter().filter(|(_, x)| x.awake && x.is_dynamic()).count();
         let mut fewest = usize::MAX;
         for step in 0..240 {
-            // A column's top box goes at step 120 (its neighbours below wake); a new box
-            // drops onto another column at step 160.
+            // A column's top box goes at step 120 (its neighbours below wake); at step 160
+            // a box drops onto another column (into the freed slot) and 200 more onto the
+            // ground beside the columns (a third chunk of slots).
             if step == 120 {
                 a.destroy_body(ids_a[11]).unwrap();
                 b.destroy_body(ids_b[11]).unwrap();
@@ -1431,7 +1432,17 @@ mod tests {
                 for w in [&mut a, &mut b] {
                     let n = w.create_body(&BodyDef::dynamic(Vec2::new(-20.0, 14.0))).unwrap();
                     w.create_shape(n, &ShapeDef::default(), &cube).unwrap();
+                    for k in 0..200 {
+                        let at = Vec2::new(40.0 + 1.5 * (k % 100) as f32, 1.0 + 2.0 * (k / 100) as f32);
+                        let n = w.create_body(&BodyDef::dynamic(at)).unwrap();
+                        w.create_shape(n, &ShapeDef::default(), &cube).unwrap();
+                    }
                 }
+                assert_eq!(
+                    a.bodies.capacity().div_ceil(step::BODY_CHUNK),
+                    3,
+                    "a third chunk of body slots"
+                );
             }
             a.step(1.0 / 60.0).unwrap();
             b.step(1.0 / 60.0).unwrap();

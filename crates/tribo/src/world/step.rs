@@ -1016,7 +1016,7 @@ impl World {
 }
 
 /// Bodies per parallel chunk of finalize and of the step's body pass.
-const BODY_CHUNK: usize = 256;
+pub(super) const BODY_CHUNK: usize = 256;
 
 /// Whether the solver gets a state for body `b`: awake and not static.
 #[inline]
