@@ -648,12 +648,11 @@ impl World {
             counts.clear();
             counts.resize(chunks, BODY_CHUNK);
         }
-        loop {
-            let found = self.prepare_chunks(g, &counts);
-            if found == counts {
-                break;
-            }
+        let found = self.prepare_chunks(g, &counts);
+        if found != counts {
             self.body_pass_retries += 1;
+            let again = self.prepare_chunks(g, &found);
+            debug_assert_eq!(again, found, "a chunk's count does not depend on the guess");
             counts = found;
         }
         self.scratch_chunk_counts = counts;
