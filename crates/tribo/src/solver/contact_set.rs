@@ -475,16 +475,21 @@ const _: () = assert!(COLORS <= FRESH as usize);
 /// −3.5 %, junkyard's −8 %). Like [`FAST`], it only orders a colour: a kept layout does not
 /// compare it.
 const SINGLE: u8 = 0x80;
+/// The flags that only order a colour ([`FAST`], [`SINGLE`]): a kept layout does not
+/// compare them.
+const ORDER_FLAGS: u8 = FAST | SINGLE;
+/// Every flag a constraint's colour byte carries beside its colour.
+const COLOUR_FLAGS: u8 = ORDER_FLAGS | FRESH;
 // No coloured constraint's byte reads as OVERFLOW.
-const _: () = assert!((COLORS as u8 - 1) | FAST | FRESH | SINGLE != OVERFLOW);
+const _: () = assert!((COLORS as u8 - 1) | COLOUR_FLAGS != OVERFLOW);
 
 /// Whether a constraint goes to the front of its colour: a face contact whose two points
 /// both carried load last step, which will most likely keep both points pushing and take
 /// the wide solver's fast path (the 2×2 block with both points active). The others —
 /// faces touching on one corner, speculative pairs not yet touching, and behind those the
 /// single points ([`SINGLE`]) — go to the back, so the fast path is not lost to a whole
-/// group of four because one lane needs the general case. Constraints of one colour share no moving body, so their order inside
-/// the colour does not change any result.
+/// group of four because one lane needs the general case. Constraints of one colour share
+/// no moving body, so their order inside the colour does not change any result.
 #[inline]
 fn fast_first(input: &ContactInput) -> bool {
     input.count == 2 && input.points[0].normal_impulse > 0.0 && input.points[1].normal_impulse > 0.0
@@ -630,10 +635,10 @@ impl ContactSolver {
                     fast_counts[k] += (key.flags & FAST != 0) as u32;
                     single_counts[k] += (key.flags & SINGLE != 0) as u32;
                     any_restitution |= key.flags & KEY_RESTITUTION != 0;
-                    self.colours.push(k as u8 | (key.flags & (FAST | FRESH | SINGLE)));
+                    self.colours.push(k as u8 | (key.flags & COLOUR_FLAGS));
                     self.last_keys.push(ColourKey {
                         colour: k as u8,
-                        flags: key.flags & !(FAST | SINGLE),
+                        flags: key.flags & !ORDER_FLAGS,
                         ..*key
                     });
                 }
@@ -692,7 +697,7 @@ impl ContactSolver {
                 self.overflow.push(cc);
                 Slot::Overflow(self.overflow.len() as u32 - 1)
             } else {
-                let k = (colour & !(FAST | FRESH | SINGLE)) as usize;
+                let k = (colour & !COLOUR_FLAGS) as usize;
                 let next = if colour & FAST != 0 {
                     &mut next[k]
                 } else if colour & SINGLE != 0 {
@@ -754,7 +759,7 @@ impl ContactSolver {
                     || key.index_a != last.index_a
                     || key.index_b != last.index_b
                     || key.colour != last.colour
-                    || key.flags & !(FAST | SINGLE) != last.flags
+                    || key.flags & !ORDER_FLAGS != last.flags
                 {
                     return false;
                 }

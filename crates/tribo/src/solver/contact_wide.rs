@@ -542,9 +542,13 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
     let (lam0, lam1) = (h.points[0].normal_impulse, h.points[1].normal_impulse);
     let (pre0, pre1) = (p0.preload, p1.preload);
     let rhs0 = vn[0] + bias[0];
+    // A point's sequential row (contact_solver::normal_row): from impulse `lam`, with
+    // normal mass `mass`, right-hand side `rhs` and its softness, clamped at zero.
+    let seq =
+        |lam: F4, mass: F4, ms: F4, rhs: F4, is: F4, pre: F4| (lam + (-(mass * ms * rhs) - is * (lam - pre))).max(zero);
     let (new0, new1) = if POINTS == 1 {
         // The sequential row of the first point (the general path's `seq0`).
-        let seq0 = (lam0 + (-(p0.normal_mass * ms[0] * rhs0) - is[0] * (lam0 - pre0))).max(zero);
+        let seq0 = seq(lam0, p0.normal_mass, ms[0], rhs0, is[0], pre0);
         apply(h, a, b, arms[0].0, arms[0].1, n.scale(seq0 - lam0));
         (seq0, zero)
     } else {
@@ -585,11 +589,11 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
                 (block0, block1)
             } else {
                 // Sequential rows where the block solve does not apply.
-                let seq0 = (lam0 + (-(p0.normal_mass * ms[0] * rhs0) - is[0] * (lam0 - pre0))).max(zero);
+                let seq0 = seq(lam0, p0.normal_mass, ms[0], rhs0, is[0], pre0);
                 let new0 = found.select(block0, seq0);
                 apply(h, a, b, arms[0].0, arms[0].1, n.scale(new0 - lam0));
                 let vn1 = relative_velocity(a, b, arms[1].0, arms[1].1).dot(n);
-                let seq1 = (lam1 + (-(p1.normal_mass * ms[1] * (vn1 + bias[1])) - is[1] * (lam1 - pre1))).max(zero);
+                let seq1 = seq(lam1, p1.normal_mass, ms[1], vn1 + bias[1], is[1], pre1);
                 let new1 = found.select(block1, seq1);
                 apply(h, a, b, arms[1].0, arms[1].1, n.scale(new1 - lam1));
                 (new0, new1)
