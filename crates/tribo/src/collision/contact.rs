@@ -45,8 +45,6 @@ pub(crate) struct PointState {
     /// Normal impulse per substep [N·s] the soft contact relaxes towards (a slowly
     /// tracking average of the manifold's load, so a steady load needs no deflection).
     pub preload: f32,
-    /// Relative normal velocity at impact [m/s] (negative = approaching).
-    pub approach_velocity: f32,
 }
 
 /// [`Contact::colour`] of a contact not yet solved, or solved in the overflow list.

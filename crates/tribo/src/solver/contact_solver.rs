@@ -1255,7 +1255,6 @@ pub(crate) fn store_impulses<S: StateRead>(
             cp.total_tangent_impulse
         };
         ps.max_normal_impulse = cp.max_normal_impulse;
-        ps.approach_velocity = cp.approach;
         let bounced = bounces(
             cc.restitution,
             cc.restitution_threshold,
