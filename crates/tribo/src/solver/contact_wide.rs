@@ -328,7 +328,7 @@ fn tangent_share(h: &WideHead, i: usize) -> F4 {
 /// static softness, `contact_solver::build_constraint`).
 #[inline(always)]
 fn static_lanes(h: &WideHead) -> M4 {
-    M4::from_bools(core::array::from_fn(|l| h.index_a[l] == 0 || h.index_b[l] == 0))
+    M4::either_zero(h.index_a, h.index_b)
 }
 
 /// The softness of each lane: (bias rate, mass scale, impulse scale).

@@ -52,6 +52,9 @@ mod sse {
         _mm_setr_epi32(a: i32, b: i32, c: i32, d: i32) -> __m128i;
         _mm_set1_epi32(a: i32) -> __m128i;
         _mm_castsi128_ps(a: __m128i) -> __m128;
+        _mm_cmpeq_epi32(a: __m128i, b: __m128i) -> __m128i;
+        _mm_or_si128(a: __m128i, b: __m128i) -> __m128i;
+        _mm_setzero_si128() -> __m128i;
         _mm_castps_si128(a: __m128) -> __m128i;
         _mm_cvtss_f32(a: __m128) -> f32;
         _mm_cvtsi128_si32(a: __m128i) -> i32;
@@ -268,6 +271,22 @@ impl M4 {
         M4(b.map(mask))
     }
 
+    /// The lanes where `a` or `b` is zero.
+    #[inline(always)]
+    pub fn either_zero(a: [u32; LANES], b: [u32; LANES]) -> M4 {
+        simd!(
+            {
+                let v = |x: [u32; LANES]| _mm_setr_epi32(x[0] as i32, x[1] as i32, x[2] as i32, x[3] as i32);
+                let z = _mm_setzero_si128();
+                sse::to_m(_mm_castsi128_ps(_mm_or_si128(
+                    _mm_cmpeq_epi32(v(a), z),
+                    _mm_cmpeq_epi32(v(b), z),
+                )))
+            },
+            M4(lanes!(|i| mask(a[i] == 0 || b[i] == 0)))
+        )
+    }
+
     /// Whether some lane is true.
     #[inline(always)]
     pub fn any(self) -> bool {
@@ -472,5 +491,9 @@ mod tests {
             assert_eq!(col.0, [a.0[i], b.0[i], (a + b).0[i], (a * b).0[i]]);
         }
         assert_eq!(transpose(cols), rows);
+        // Body indices: 0 is the static body; u32::MAX must not read as a negative zero.
+        let (ia, ib) = ([0, 7, 3, u32::MAX], [5, 0, 9, 1]);
+        assert_eq!(M4::either_zero(ia, ib).0, [u32::MAX, u32::MAX, 0, 0]);
+        assert_eq!(M4::either_zero([0; LANES], [0; LANES]).0, [u32::MAX; LANES]);
     }
 }
