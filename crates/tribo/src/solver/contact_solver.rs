@@ -146,6 +146,21 @@ pub(crate) struct ConstraintBodies {
     pub center_b: Vec2,
 }
 
+impl ConstraintBodies {
+    /// The inverse masses and inertias (A's, then B's), side by side in the record: one
+    /// row of the wide build's transpose.
+    #[inline(always)]
+    pub fn mass_row(&self) -> [f32; 4] {
+        [self.inv_mass_a, self.inv_i_a, self.inv_mass_b, self.inv_i_b]
+    }
+
+    /// The two centres of mass [m], side by side in the record.
+    #[inline(always)]
+    pub fn centre_row(&self) -> [f32; 4] {
+        [self.center_a.x, self.center_a.y, self.center_b.x, self.center_b.y]
+    }
+}
+
 /// What building a constraint reads of a contact, copied out in contact order (compact
 /// and contiguous, so the build in colour order does not chase 400-byte contact records
 /// across memory).
@@ -177,7 +192,29 @@ pub(crate) struct InputPoint {
     pub fresh: bool,
 }
 
+impl InputPoint {
+    /// The point [m], its separation [m] and normal impulse [N·s], side by side in the
+    /// record: one row of the wide build's transpose.
+    #[inline(always)]
+    pub fn row(&self) -> [f32; 4] {
+        [self.point.x, self.point.y, self.separation, self.normal_impulse]
+    }
+}
+
 impl ContactInput {
+    /// μs, μd, restitution and its threshold [m/s], side by side in the record: one row of
+    /// the wide build's transpose.
+    #[inline(always)]
+    pub fn material_row(&self) -> [f32; 4] {
+        [self.mu_s, self.mu_d, self.restitution, self.restitution_threshold]
+    }
+
+    /// Rolling resistance [m], surface speed [m/s], rolling impulse [N·m·s] (and a 0).
+    #[inline(always)]
+    pub fn surface_row(&self) -> [f32; 4] {
+        [self.rolling_resistance, self.tangent_speed, self.rolling_impulse, 0.0]
+    }
+
     /// No points, no material.
     pub const EMPTY: ContactInput = ContactInput {
         normal: Vec2::ZERO,

@@ -746,34 +746,25 @@ pub(crate) fn build_group<S: StateRead>(
         }))
     };
     let count_of = |input: &ContactInput| input.count.min(2);
-    let (center_a, center_b) = (
-        V4 {
-            x: each(&|_, b| b.center_a.x),
-            y: each(&|_, b| b.center_a.y),
-        },
-        V4 {
-            x: each(&|_, b| b.center_b.x),
-            y: each(&|_, b| b.center_b.y),
-        },
-    );
-    let point: [V4; 2] = core::array::from_fn(|i| V4 {
-        x: each(&|input, _| {
-            if i < count_of(input) {
-                input.points[i].point.x
-            } else {
-                0.0
-            }
-        }),
-        y: each(&|input, _| {
-            if i < count_of(input) {
-                input.points[i].point.y
-            } else {
-                0.0
-            }
-        }),
-    });
+    // Fields that lie side by side in a candidate come as one 16-byte row per lane,
+    // transposed into four lanes of each (zeros in an empty lane): eight shuffles instead
+    // of sixteen single-lane loads and inserts per row.
+    let columns = |row: &dyn Fn(&ContactInput, &ConstraintBodies) -> [f32; LANES]| {
+        transpose(core::array::from_fn(|l| {
+            F4(lanes[l].map_or([0.0; LANES], |(_, input, b)| row(input, b)))
+        }))
+    };
+    let [cax, cay, cbx, cby] = columns(&|_, b| b.centre_row());
+    let (center_a, center_b) = (V4 { x: cax, y: cay }, V4 { x: cbx, y: cby });
+    let [ma, ia, mb, ib] = columns(&|_, b| b.mass_row());
+    // Each point's (x, y, separation, normal impulse); kept where the lane has the point.
+    let point_rows: [[F4; 4]; 2] = core::array::from_fn(|i| columns(&|input, _| input.points[i].row()));
     let has: [M4; 2] = core::array::from_fn(|i| {
         M4::from_bools(lanes.map(|lane| lane.is_some_and(|(_, input, _)| i < count_of(input))))
+    });
+    let point: [V4; 2] = core::array::from_fn(|i| V4 {
+        x: has[i].select(point_rows[i][0], zero),
+        y: has[i].select(point_rows[i][1], zero),
     });
     let base_drift: [F4; 2] = core::array::from_fn(|i| {
         each(&|input, _| {
@@ -789,10 +780,13 @@ pub(crate) fn build_group<S: StateRead>(
         x: each(&|input, _| input.normal.x),
         y: each(&|input, _| input.normal.y),
     };
-    hd.inv_mass_a = each(&|_, b| b.inv_mass_a);
-    hd.inv_i_a = each(&|_, b| b.inv_i_a);
-    hd.inv_mass_b = each(&|_, b| b.inv_mass_b);
-    hd.inv_i_b = each(&|_, b| b.inv_i_b);
+    (hd.inv_mass_a, hd.inv_i_a, hd.inv_mass_b, hd.inv_i_b) = (ma, ia, mb, ib);
+    for i in 0..2 {
+        out.points[i].base_separation = has[i].select(point_rows[i][2], zero);
+        if warm {
+            hd.points[i].normal_impulse = has[i].select(point_rows[i][3], zero);
+        }
+    }
     // Summed as `pack_state` sums (`Iterator::sum` of f32 starts at −0.0, and −0.0 + x is
     // x: the same bits, the same sign of a zero sum), without a loop; +0.0 in an empty lane.
     hd.tangent_impulse = each(&|input, _| {
@@ -804,6 +798,13 @@ pub(crate) fn build_group<S: StateRead>(
         }
     });
     c.base_drift = base_drift.map(|d| d.0);
+    let [mu_s, mu_d, restitution, threshold] = columns(&|input, _| input.material_row());
+    (c.mu_s, c.mu_d, c.restitution, c.restitution_threshold) = (mu_s.0, mu_d.0, restitution.0, threshold.0);
+    let [rolling_resistance, tangent_speed, rolling_impulse, _] = columns(&|input, _| input.surface_row());
+    (out.rolling_resistance, out.tangent_speed) = (rolling_resistance, tangent_speed);
+    if warm {
+        hd.rolling_impulse = rolling_impulse;
+    }
     for (l, lane) in lanes.iter().enumerate() {
         let Some((contact, input, b)) = *lane else {
             // An empty lane: nothing but a sticking, empty friction row.
@@ -813,8 +814,6 @@ pub(crate) fn build_group<S: StateRead>(
         let count = count_of(input);
         c.contact[l] = contact;
         c.count[l] = count as u8;
-        c.restitution[l] = input.restitution;
-        c.restitution_threshold[l] = input.restitution_threshold;
         c.any_restitution |= input.restitution > 0.0;
         hd.any_restitution |= input.restitution > 0.0;
         c.height[l] = if count > 0 { input.points[0].point.dot(up) } else { 0.0 };
@@ -822,12 +821,7 @@ pub(crate) fn build_group<S: StateRead>(
         hd.index_b[l] = b.index_b;
         hd.write_a[l] = (b.inv_mass_a > 0.0 || b.inv_i_a > 0.0) && b.index_a != 0;
         hd.write_b[l] = (b.inv_mass_b > 0.0 || b.inv_i_b > 0.0) && b.index_b != 0;
-        c.mu_s[l] = input.mu_s;
-        c.mu_d[l] = input.mu_d;
-        out.tangent_speed.0[l] = input.tangent_speed;
-        out.rolling_resistance.0[l] = input.rolling_resistance;
         let rolling_impulse = if warm { input.rolling_impulse } else { 0.0 };
-        hd.rolling_impulse.0[l] = rolling_impulse;
         hd.any_rolling |= input.rolling_resistance > 0.0 || rolling_impulse != 0.0;
         let states_ab = input.points[..count]
             .iter()
@@ -841,9 +835,7 @@ pub(crate) fn build_group<S: StateRead>(
         let mut row_stick = true;
         for (i, ip) in input.points[..count].iter().enumerate() {
             let wp = &mut out.points[i];
-            wp.base_separation.0[l] = ip.separation;
             if warm {
-                hd.points[i].normal_impulse.0[l] = ip.normal_impulse;
                 wp.preload.0[l] = ip.preload;
             }
             let stick = match states_ab {
@@ -858,12 +850,12 @@ pub(crate) fn build_group<S: StateRead>(
             row_stick &= stick;
         }
         out.stick.0[l] = if row_stick { u32::MAX } else { 0 };
-        out.mu.0[l] = if row_stick { input.mu_s } else { input.mu_d };
     }
+    // μs where the row sticks (an empty lane: 0), μd where it slides.
+    out.mu = out.stick.select(mu_s, mu_d);
     // Four lanes at once (contact_solver::build_constraint and pack).
     let n = hd.normal;
     let t = V4 { x: n.y, y: -n.x };
-    let (ma, ia, mb, ib) = (hd.inv_mass_a, hd.inv_i_a, hd.inv_mass_b, hd.inv_i_b);
     // k = m_a⁻¹ + m_b⁻¹ + I_a⁻¹ (r_a × d)² + I_b⁻¹ (r_b × d)² (effective_mass_inv).
     let k_of = |r_a: V4, r_b: V4, d: V4| {
         let (ra, rb) = (r_a.cross(d), r_b.cross(d));
