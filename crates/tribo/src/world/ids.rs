@@ -42,6 +42,9 @@ pub(crate) struct Arena<T> {
     slots: Vec<Slot<T>>,
     free: Vec<u32>,
     len: usize,
+    /// How many times a value was handed out for writing, inserted or removed
+    /// ([`Arena::writes`]).
+    writes: u64,
 }
 
 impl<T> Default for Arena<T> {
@@ -50,13 +53,24 @@ impl<T> Default for Arena<T> {
             slots: Vec::new(),
             free: Vec::new(),
             len: 0,
+            writes: 0,
         }
     }
 }
 
 impl<T> Arena<T> {
+    /// A count that every write access (`insert`, `remove`, `get_mut`, `at_mut`,
+    /// `for_each_live_mut*`) advances, but [`Arena::at_mut_quiet`]: while it stays the same,
+    /// no value has changed (what a copy made of the values, like the step's solver
+    /// entries of the bodies, needs to know to be kept).
+    #[inline]
+    pub fn writes(&self) -> u64 {
+        self.writes
+    }
+
     /// Inserts a value; returns (index, generation).
     pub fn insert(&mut self, value: T) -> (u32, u32) {
+        self.writes += 1;
         self.len += 1;
         if let Some(i) = self.free.pop() {
             let slot = &mut self.slots[i as usize];
@@ -73,6 +87,7 @@ impl<T> Arena<T> {
 
     /// Removes the value if the generation matches.
     pub fn remove(&mut self, index: u32, generation: u32) -> Option<T> {
+        self.writes += 1;
         let slot = self.slots.get_mut(index as usize)?;
         if slot.generation != generation || slot.value.is_none() {
             return None;
@@ -97,6 +112,7 @@ impl<T> Arena<T> {
     /// The value if the id is live.
     #[inline]
     pub fn get_mut(&mut self, index: u32, generation: u32) -> Option<&mut T> {
+        self.writes += 1;
         let slot = self.slots.get_mut(index as usize)?;
         if slot.generation == generation {
             slot.value.as_mut()
@@ -131,6 +147,14 @@ impl<T> Arena<T> {
     /// The value at a slot index, whatever its generation (internal links).
     #[inline]
     pub fn at_mut(&mut self, index: u32) -> Option<&mut T> {
+        self.writes += 1;
+        self.at_mut_quiet(index)
+    }
+
+    /// [`Arena::at_mut`] without advancing [`Arena::writes`]: for a caller that keeps the
+    /// copies of what it writes up to date itself.
+    #[inline]
+    pub fn at_mut_quiet(&mut self, index: u32) -> Option<&mut T> {
         self.slots.get_mut(index as usize).and_then(|s| s.value.as_mut())
     }
 
@@ -140,6 +164,7 @@ impl<T> Arena<T> {
     where
         T: Send,
     {
+        self.writes += 1;
         crate::solver::for_each_mut(parallel, &mut self.slots, min_len, |i, slot| {
             if let Some(v) = slot.value.as_mut() {
                 f(i as u32, v);
@@ -158,6 +183,7 @@ impl<T> Arena<T> {
     ) where
         T: Send,
     {
+        self.writes += 1;
         crate::solver::for_each_mut2(parallel, &mut self.slots, other, min_len, |i, slot, u| {
             if let Some(v) = slot.value.as_mut() {
                 f(i as u32, v, u);

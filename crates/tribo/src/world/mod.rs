@@ -234,6 +234,17 @@ pub struct World {
     pub(crate) scratch_chunk_counts: Vec<usize>,
     /// Parallel body passes run again because a chunk's count changed (for tests).
     pub(crate) body_pass_retries: u64,
+    /// Left by a one-thread finalize that wrote the next step's solver entries, states and
+    /// step data of every solved body: the bodies' write count then, the gravity, and
+    /// whether some body is loaded. While the count and gravity are the same, the next
+    /// body pass is not needed (see `World::prepare_bodies`).
+    pub(crate) next_entries: Option<(u64, Vec2, bool)>,
+    /// Body passes skipped because finalize had made their entries (for tests).
+    pub(crate) body_pass_skips: u64,
+    /// The bodies' write count when this step's solver entries were made (by the body
+    /// pass or, before the step, by finalize): finalize brings them up to date only when
+    /// no body was written since.
+    pub(crate) entries_writes: u64,
     /// Static shapes found by the continuous check (`stop_at_static_shapes`).
     pub(crate) scratch_found: Vec<u32>,
     /// Per body slot, what the solver's constraints need of it (rebuilt every step).
@@ -302,6 +313,9 @@ impl World {
             scratch_touched: Vec::new(),
             scratch_chunk_counts: Vec::new(),
             body_pass_retries: 0,
+            next_entries: None,
+            body_pass_skips: 0,
+            entries_writes: 0,
             scratch_found: Vec::new(),
             solver_bodies: Vec::new(),
             step_count: 0,
@@ -1453,6 +1467,93 @@ mod tests {
         }
         assert!(fewest < 360, "some bodies fell asleep (fewest awake: {fewest})");
         assert!(b.body_pass_retries >= 2, "retries: {}", b.body_pass_retries);
+    }
+
+    /// A one-thread step skips the body pass when the last finalize made its entries and no
+    /// body was written since (`World::next_entries`). A world that always runs the pass
+    /// must match it bit for bit through every kind of write between steps: velocity,
+    /// force, teleport, gravity, mass (a new shape), bodies created and destroyed, islands
+    /// falling asleep and woken. And the skip must happen (else this proves nothing), but
+    /// not in the steps after those writes.
+    #[test]
+    fn a_skipped_body_pass_matches_the_pass() {
+        let cube = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
+        let make = || {
+            let mut w = World::new(WorldDef::default()).unwrap();
+            let ground = w.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
+            let slab = Shape::Polygon(Polygon::new_box(100.0, 1.0).unwrap());
+            w.create_shape(ground, &ShapeDef::default(), &slab).unwrap();
+            let mut ids = Vec::new();
+            for col in 0..6 {
+                for row in 0..5 {
+                    let at = Vec2::new(3.0 * col as f32 - 9.0, 0.5 + row as f32);
+                    let b = w.create_body(&BodyDef::dynamic(at)).unwrap();
+                    w.create_shape(b, &ShapeDef::default(), &cube).unwrap();
+                    ids.push(b);
+                }
+            }
+            (w, ids)
+        };
+        let ((mut a, ids), (mut b, _)) = (make(), make());
+        let (mut skips_before, mut skipped_after_write) = (0, Vec::new());
+        let mut fewest_awake = usize::MAX;
+        for step in 0..400 {
+            // The same write to both worlds (ids are the same: built alike).
+            let write: Option<&dyn Fn(&mut World)> = match step {
+                40 => Some(&|w| w.set_body_linear_velocity(ids[4], Vec2::new(2.0, 3.0)).unwrap()),
+                60 => Some(&|w| w.apply_force_to_center(ids[9], Vec2::new(0.0, 400.0), true).unwrap()),
+                80 => Some(&|w| w.set_body_transform(ids[14], Vec2::new(20.0, 3.0), 0.3).unwrap()),
+                100 => Some(&|w| w.set_gravity(Vec2::new(0.5, -9.0)).unwrap()),
+                120 => Some(&|w| {
+                    let extra = Shape::Polygon(Polygon::new_offset_box(0.2, 0.2, Vec2::new(0.6, 0.0), 0.0).unwrap());
+                    w.create_shape(ids[19], &ShapeDef::default(), &extra).unwrap();
+                }),
+                140 => Some(&|w| {
+                    let n = w.create_body(&BodyDef::dynamic(Vec2::new(-20.0, 2.0))).unwrap();
+                    let cube = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
+                    w.create_shape(n, &ShapeDef::default(), &cube).unwrap();
+                }),
+                160 => Some(&|w| w.destroy_body(ids[24]).unwrap()),
+                // By step 380 the piles have fallen asleep; this wakes one.
+                380 => Some(&|w| w.set_body_awake(ids[1], true).unwrap()),
+                _ => None,
+            };
+            if let Some(f) = write {
+                f(&mut a);
+                f(&mut b);
+            }
+            let skips = a.body_pass_skips;
+            b.next_entries = None; // `b` always runs its body pass
+            a.step(1.0 / 60.0).unwrap();
+            b.step(1.0 / 60.0).unwrap();
+            if write.is_some() {
+                skipped_after_write.push((step, a.body_pass_skips != skips));
+            }
+            if step < 40 {
+                skips_before = a.body_pass_skips;
+            }
+            if step < 380 {
+                let awake = a.bodies.iter().filter(|(_, x)| x.is_dynamic() && x.awake).count();
+                fewest_awake = fewest_awake.min(awake);
+            }
+            for ((_, x), (_, y)) in a.bodies.iter().zip(b.bodies.iter()) {
+                assert_eq!((x.xf, x.v, x.w, x.awake), (y.xf, y.v, y.w, y.awake), "step {step}");
+            }
+        }
+        assert_eq!(b.body_pass_skips, 0);
+        assert!(
+            skips_before >= 38,
+            "the pass was skipped in {skips_before} of the first 40 steps"
+        );
+        assert!(
+            skipped_after_write.iter().all(|&(_, skipped)| !skipped),
+            "a step right after a write skipped the pass: {skipped_after_write:?}"
+        );
+        assert!(a.body_pass_skips > 300, "skips: {}", a.body_pass_skips);
+        assert!(
+            fewest_awake == 0,
+            "the piles fell asleep before step 380 (fewest awake: {fewest_awake})"
+        );
     }
 
     /// A shower of spinning boxes thrown down onto a slab between two walls (sleep off).
