@@ -1477,16 +1477,27 @@ mod tests {
     /// not in the steps after those writes.
     #[test]
     fn a_skipped_body_pass_matches_the_pass() {
+        skipped_body_pass_matches_the_pass(1);
+        skipped_body_pass_matches_the_pass(2);
+    }
+
+    /// [`a_skipped_body_pass_matches_the_pass`] with `workers` threads.
+    fn skipped_body_pass_matches_the_pass(workers: u32) {
         let cube = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
         let make = || {
-            let mut w = World::new(WorldDef::default()).unwrap();
+            let mut w = World::new(WorldDef {
+                workers,
+                ..WorldDef::default()
+            })
+            .unwrap();
             let ground = w.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
             let slab = Shape::Polygon(Polygon::new_box(100.0, 1.0).unwrap());
             w.create_shape(ground, &ShapeDef::default(), &slab).unwrap();
             let mut ids = Vec::new();
-            for col in 0..6 {
+            // 60 columns of 5: 300 bodies, two chunks of body slots for the parallel pass.
+            for col in 0..60 {
                 for row in 0..5 {
-                    let at = Vec2::new(3.0 * col as f32 - 9.0, 0.5 + row as f32);
+                    let at = Vec2::new(1.5 * col as f32 - 45.0, 0.5 + row as f32);
                     let b = w.create_body(&BodyDef::dynamic(at)).unwrap();
                     w.create_shape(b, &ShapeDef::default(), &cube).unwrap();
                     ids.push(b);
@@ -1502,14 +1513,14 @@ mod tests {
             let write: Option<&dyn Fn(&mut World)> = match step {
                 40 => Some(&|w| w.set_body_linear_velocity(ids[4], Vec2::new(2.0, 3.0)).unwrap()),
                 60 => Some(&|w| w.apply_force_to_center(ids[9], Vec2::new(0.0, 400.0), true).unwrap()),
-                80 => Some(&|w| w.set_body_transform(ids[14], Vec2::new(20.0, 3.0), 0.3).unwrap()),
+                80 => Some(&|w| w.set_body_transform(ids[14], Vec2::new(-60.0, 3.0), 0.3).unwrap()),
                 100 => Some(&|w| w.set_gravity(Vec2::new(0.5, -9.0)).unwrap()),
                 120 => Some(&|w| {
                     let extra = Shape::Polygon(Polygon::new_offset_box(0.2, 0.2, Vec2::new(0.6, 0.0), 0.0).unwrap());
                     w.create_shape(ids[19], &ShapeDef::default(), &extra).unwrap();
                 }),
                 140 => Some(&|w| {
-                    let n = w.create_body(&BodyDef::dynamic(Vec2::new(-20.0, 2.0))).unwrap();
+                    let n = w.create_body(&BodyDef::dynamic(Vec2::new(-70.0, 2.0))).unwrap();
                     let cube = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
                     w.create_shape(n, &ShapeDef::default(), &cube).unwrap();
                 }),
@@ -1537,7 +1548,11 @@ mod tests {
                 fewest_awake = fewest_awake.min(awake);
             }
             for ((_, x), (_, y)) in a.bodies.iter().zip(b.bodies.iter()) {
-                assert_eq!((x.xf, x.v, x.w, x.awake), (y.xf, y.v, y.w, y.awake), "step {step}");
+                assert_eq!(
+                    (x.xf, x.v, x.w, x.awake),
+                    (y.xf, y.v, y.w, y.awake),
+                    "{workers}: step {step}"
+                );
             }
         }
         assert_eq!(b.body_pass_skips, 0);

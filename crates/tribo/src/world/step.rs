@@ -17,8 +17,8 @@ use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::{Candidate, Candidates, ColourKey};
 use crate::solver::{
-    claim_each, for_each_chunk_mut4, loads, solve_step, BodySim, BodyState, SharedState, SolverBody, StepConstraints,
-    StepContext,
+    claim_each, for_each_chunk_mut4, for_each_mut, loads, solve_step, BodySim, BodyState, SharedState, SolverBody,
+    StepConstraints, StepContext,
 };
 use crate::world::Arena;
 use crate::world::{box_velocity, next_box};
@@ -598,13 +598,13 @@ impl World {
     fn prepare_bodies(&mut self, parallel: bool) {
         let g = self.def.gravity;
         let capacity = self.bodies.capacity();
-        // The last (one-thread) finalize made these entries from the records it had just
-        // written, and no body has been written since: what this pass would write is
-        // there already (a read of every body record saved: large_pyramid's pass took
-        // 60 µs of a 3.3 ms step).
+        // The last finalize made these entries from the records it had just written, and
+        // no body has been written since: what this pass would write is there already (a
+        // read of every body record saved: large_pyramid's pass took 60 µs of a 3.3 ms
+        // step on one thread, 30 µs of 2 ms on two).
         let made = self.next_entries.take();
         if let Some((_, _, loaded)) =
-            made.filter(|&(writes, gravity, _)| !parallel && writes == self.bodies.writes() && gravity == g)
+            made.filter(|&(writes, gravity, _)| writes == self.bodies.writes() && gravity == g)
         {
             if self.solver_bodies.len() == capacity {
                 self.any_load = loaded;
@@ -792,18 +792,36 @@ impl World {
             self.finalize_one_thread(dt);
             return;
         }
-        // Poses and sleep timers in parallel: each body writes itself.
-        let (states, sleep_on, solver_bodies) = (&self.states, self.def.enable_sleep, &self.solver_bodies);
+        // Poses and sleep timers in parallel: each body writes itself and the pose and
+        // velocity in its solver entry (as the one-thread finalize, see there: with the
+        // states reset below, the next step's entries when no body is written before it).
+        use core::sync::atomic::{AtomicBool, Ordering::Relaxed};
+        let fresh = self.bodies.writes() == self.entries_writes;
+        let (states, sleep_on) = (&self.states, self.def.enable_sleep);
         let limit = self.def.max_linear_speed;
-        let any_fast = core::sync::atomic::AtomicBool::new(false);
-        self.bodies.for_each_live_mut(parallel, BODY_CHUNK, |bi, b| {
-            let index = solver_bodies.get(bi as usize).map_or(0, |sb| sb.index);
-            if let Some(&s) = states.get(index as usize).filter(|_| index != 0) {
-                if advance_body(b, s, dt, sleep_on) && boxes_care(b, dt, limit) {
-                    any_fast.store(true, core::sync::atomic::Ordering::Relaxed);
+        let (any_fast, forced) = (AtomicBool::new(false), AtomicBool::new(false));
+        self.bodies
+            .for_each_live_mut_with(parallel, BODY_CHUNK, &mut self.solver_bodies, |_, b, sb| {
+                let index = sb.index;
+                if let Some(&s) = states.get(index as usize).filter(|_| index != 0) {
+                    // A force this step: the step data change (`body_sim`), and are not made here.
+                    if b.force != Vec2::ZERO || b.torque != 0.0 {
+                        forced.store(true, Relaxed);
+                    }
+                    if advance_body(b, s, dt, sleep_on) && boxes_care(b, dt, limit) {
+                        any_fast.store(true, Relaxed);
+                    }
+                    (sb.center, sb.xf, sb.v, sb.w) = (b.center, b.xf, b.v, b.w);
                 }
-            }
-        });
+            });
+        // This pass's own writes are in the entries; any later one is not.
+        let writes = self.bodies.writes();
+        if fresh && !forced.into_inner() {
+            // Each state as `body_state` makes it from its body, whose velocity is now the
+            // state's (a non-finite one is reported below: a write, so no skip).
+            for_each_mut(parallel, &mut self.states[1..], BODY_CHUNK, |_, s| *s = next_state(s));
+            self.next_entries = Some((writes, self.def.gravity, self.any_load));
+        }
         let mut touched = core::mem::take(&mut self.scratch_touched);
         self.touched_slots(any_fast.into_inner(), &mut touched);
         // The boxes of one-shape bodies are computed shape by shape in parallel; a box that
@@ -1098,6 +1116,19 @@ fn solver_body(b: Option<&Body>, index: u32) -> SolverBody {
         w: b.w,
         max_extent: b.max_extent,
         reach: b.max_extent + b.local_center.length(),
+    }
+}
+
+/// The state of the step after one that ended with state `s` (its body's, when finalize
+/// has written `s`'s velocity into it: [`body_state`]'s).
+#[inline]
+fn next_state(s: &BodyState) -> BodyState {
+    BodyState {
+        v: s.v,
+        w: s.w,
+        touched: 0.0,
+        dp: Vec2::ZERO,
+        dq: Rot::IDENTITY,
     }
 }
 
