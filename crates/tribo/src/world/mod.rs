@@ -1407,30 +1407,41 @@ mod tests {
     /// fall asleep, wake, come and go change the counts; the two-worker world must stay
     /// bit for bit the one-worker world in every step, and the pass must have run again
     /// (else the test proves nothing about the retry).
+    /// A world of `workers` threads with a slab of half-width `slab` [m] and `cols` columns
+    /// of `rows` unit boxes, `pitch` [m] apart from x = `x0`; the boxes' ids column by column.
+    fn columns_of_boxes(
+        workers: u32,
+        slab: f32,
+        (cols, rows): (usize, usize),
+        pitch: f32,
+        x0: f32,
+    ) -> (World, Vec<BodyId>) {
+        let cube = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
+        let mut w = World::new(WorldDef {
+            workers,
+            ..WorldDef::default()
+        })
+        .unwrap();
+        let ground = w.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
+        let slab = Shape::Polygon(Polygon::new_box(slab, 1.0).unwrap());
+        w.create_shape(ground, &ShapeDef::default(), &slab).unwrap();
+        let mut ids = Vec::new();
+        for col in 0..cols {
+            for row in 0..rows {
+                let at = Vec2::new(pitch * col as f32 + x0, 0.5 + row as f32);
+                let b = w.create_body(&BodyDef::dynamic(at)).unwrap();
+                w.create_shape(b, &ShapeDef::default(), &cube).unwrap();
+                ids.push(b);
+            }
+        }
+        (w, ids)
+    }
+
     #[test]
     fn the_parallel_body_pass_follows_sleep_and_new_bodies() {
         let cube = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
-        let make = |workers: u32| {
-            let mut w = World::new(WorldDef {
-                workers,
-                ..WorldDef::default()
-            })
-            .unwrap();
-            let ground = w.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
-            let slab = Shape::Polygon(Polygon::new_box(400.0, 1.0).unwrap());
-            w.create_shape(ground, &ShapeDef::default(), &slab).unwrap();
-            // 30 columns of 12 boxes, 2 m apart: 360 bodies in two chunks of slots.
-            let mut ids = Vec::new();
-            for col in 0..30 {
-                for row in 0..12 {
-                    let at = Vec2::new(2.0 * col as f32 - 30.0, 0.5 + row as f32);
-                    let b = w.create_body(&BodyDef::dynamic(at)).unwrap();
-                    w.create_shape(b, &ShapeDef::default(), &cube).unwrap();
-                    ids.push(b);
-                }
-            }
-            (w, ids)
-        };
+        // 30 columns of 12 boxes, 2 m apart: 360 bodies in two chunks of slots.
+        let make = |workers: u32| columns_of_boxes(workers, 400.0, (30, 12), 2.0, -30.0);
         let ((mut a, ids_a), (mut b, ids_b)) = (make(1), make(2));
         let awake = |w: &World| w.bodies.iter().filter(|(_, x)| x.awake && x.is_dynamic()).count();
         let mut fewest = usize::MAX;
@@ -1483,28 +1494,8 @@ mod tests {
 
     /// [`a_skipped_body_pass_matches_the_pass`] with `workers` threads.
     fn skipped_body_pass_matches_the_pass(workers: u32) {
-        let cube = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
-        let make = || {
-            let mut w = World::new(WorldDef {
-                workers,
-                ..WorldDef::default()
-            })
-            .unwrap();
-            let ground = w.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
-            let slab = Shape::Polygon(Polygon::new_box(100.0, 1.0).unwrap());
-            w.create_shape(ground, &ShapeDef::default(), &slab).unwrap();
-            let mut ids = Vec::new();
-            // 60 columns of 5: 300 bodies, two chunks of body slots for the parallel pass.
-            for col in 0..60 {
-                for row in 0..5 {
-                    let at = Vec2::new(1.5 * col as f32 - 45.0, 0.5 + row as f32);
-                    let b = w.create_body(&BodyDef::dynamic(at)).unwrap();
-                    w.create_shape(b, &ShapeDef::default(), &cube).unwrap();
-                    ids.push(b);
-                }
-            }
-            (w, ids)
-        };
+        // 60 columns of 5: 300 bodies, two chunks of body slots for the parallel pass.
+        let make = || columns_of_boxes(workers, 100.0, (60, 5), 1.5, -45.0);
         let ((mut a, ids), (mut b, _)) = (make(), make());
         let (mut skips_before, mut skipped_after_write) = (0, Vec::new());
         let mut fewest_awake = usize::MAX;
