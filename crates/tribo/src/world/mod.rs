@@ -234,10 +234,11 @@ pub struct World {
     pub(crate) scratch_chunk_counts: Vec<usize>,
     /// Parallel body passes run again because a chunk's count changed (for tests).
     pub(crate) body_pass_retries: u64,
-    /// Left by a one-thread finalize that wrote the next step's solver entries, states and
-    /// step data of every solved body: the bodies' write count then, the gravity, and
-    /// whether some body is loaded. While the count and gravity are the same, the next
-    /// body pass is not needed (see `World::prepare_bodies`).
+    /// Left by a finalize that wrote the next step's solver entries, states and step data
+    /// of every solved body (one thread: all three; with threads: the entries' poses and
+    /// the states, when no force acted, so the step data hold): the bodies' write count
+    /// then, the gravity, and whether some body is loaded. While the count and gravity are
+    /// the same, the next body pass is not needed (see `World::prepare_bodies`).
     pub(crate) next_entries: Option<(u64, Vec2, bool)>,
     /// Body passes skipped because finalize had made their entries (for tests).
     pub(crate) body_pass_skips: u64,
