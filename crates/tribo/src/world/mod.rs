@@ -242,6 +242,10 @@ pub struct World {
     pub(crate) next_entries: Option<(u64, Vec2, bool)>,
     /// Body passes skipped because finalize had made their entries (for tests).
     pub(crate) body_pass_skips: u64,
+    /// The last entries finalize made were not used (a body was written before the next
+    /// step, as a scene's per-step hook does): finalize then makes them only every
+    /// [`step::ENTRIES_RETRY`] steps, not in every step for nothing.
+    pub(crate) entries_unused: bool,
     /// The bodies' write count when this step's solver entries were made (by the body
     /// pass or, before the step, by finalize): finalize brings them up to date only when
     /// no body was written since.
@@ -316,6 +320,7 @@ impl World {
             body_pass_retries: 0,
             next_entries: None,
             body_pass_skips: 0,
+            entries_unused: false,
             entries_writes: 0,
             scratch_found: Vec::new(),
             solver_bodies: Vec::new(),
@@ -1004,7 +1009,8 @@ impl World {
             return;
         }
         if b.awake {
-            if let Some(b) = self.bodies.at_mut(body_index) {
+            // Only the sleep timer, which no solver entry reads (`World::next_entries`).
+            if let Some(b) = self.bodies.at_mut_quiet(body_index) {
                 b.sleep_time = 0.0;
             }
             return;
@@ -1160,7 +1166,8 @@ impl World {
             .pairs
             .remove(&crate::collision::contact::pair_key(c.shape_a.index, c.shape_b.index));
         for bi in [c.body_a, c.body_b] {
-            if let Some(b) = self.bodies.at_mut(bi) {
+            // Only the contact lists, which no solver entry reads (`World::next_entries`).
+            if let Some(b) = self.bodies.at_mut_quiet(bi) {
                 if let Some(pos) = b.contacts.iter().position(|&x| x == ci) {
                     b.contacts.swap_remove(pos);
                     b.contact_keys.swap_remove(pos);
@@ -1548,8 +1555,10 @@ mod tests {
             }
         }
         assert_eq!(b.body_pass_skips, 0);
+        // All but step 0, the step after the piles fall asleep (step 30: a write) and those
+        // until finalize makes the entries again (every `ENTRIES_RETRY` steps once unused).
         assert!(
-            skips_before >= 38,
+            skips_before >= 36,
             "the pass was skipped in {skips_before} of the first 40 steps"
         );
         assert!(

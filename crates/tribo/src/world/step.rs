@@ -321,7 +321,9 @@ impl World {
         };
         self.broad_phase.pairs.insert(pair_key(sa, sb), ci);
         for bi in [body_a, body_b] {
-            if let Some(b) = self.bodies.at_mut(bi) {
+            // Only the contact lists, which no solver entry reads: not a write the body
+            // pass's skip needs to see (`World::next_entries`).
+            if let Some(b) = self.bodies.at_mut_quiet(bi) {
                 b.contacts.push(ci);
                 b.contact_keys.push(pair_key(sa, sb));
             }
@@ -610,9 +612,12 @@ impl World {
                 self.any_load = loaded;
                 self.body_pass_skips += 1;
                 self.entries_writes = self.bodies.writes();
+                self.entries_unused = false;
                 return;
             }
         }
+        // Entries made for nothing (with none made, the last verdict stands).
+        self.entries_unused |= made.is_some();
         self.entries_writes = self.bodies.writes();
         // Every entry is written below (an empty slot's too), so the arrays are only
         // resized, not cleared first: many_pyramids' 22 000 entries are 1.4 MB.
@@ -796,7 +801,7 @@ impl World {
         // velocity in its solver entry (as the one-thread finalize, see there: with the
         // states reset below, the next step's entries when no body is written before it).
         use core::sync::atomic::{AtomicBool, Ordering::Relaxed};
-        let fresh = self.bodies.writes() == self.entries_writes;
+        let fresh = self.bodies.writes() == self.entries_writes && self.make_entries();
         let (states, sleep_on) = (&self.states, self.def.enable_sleep);
         let limit = self.def.max_linear_speed;
         let (any_fast, forced) = (AtomicBool::new(false), AtomicBool::new(false));
@@ -892,7 +897,7 @@ impl World {
         // Only when no body was written since this step's entries were made: then only
         // what finalize writes (pose, velocity, the forces it clears) changes in them.
         let writes = self.bodies.writes();
-        let fresh = writes == self.entries_writes;
+        let fresh = writes == self.entries_writes && self.make_entries();
         let mut loaded = false;
         for k in 1..self.states.len() {
             self.prefetch_finalize(k);
@@ -925,6 +930,13 @@ impl World {
         }
         self.scratch_touched = touched;
         self.next_entries = fresh.then_some((writes, g, loaded));
+    }
+
+    /// Whether finalize makes the next step's entries (see [`World::finalize_one_thread`]):
+    /// not while the last ones went unused, but every [`ENTRIES_RETRY`] steps (whether
+    /// they are used changes no result, only the time).
+    fn make_entries(&self) -> bool {
+        !self.entries_unused || self.step_count % ENTRIES_RETRY == 0
     }
 
     /// Whether body `bi` is a bullet, or `None` when its state went non-finite in this
@@ -1080,6 +1092,10 @@ impl World {
 
 /// Bodies per parallel chunk of finalize and of the step's body pass.
 pub(super) const BODY_CHUNK: usize = 256;
+
+/// Steps between finalize's tries to make the next step's solver entries while the last
+/// ones went unused ([`World::entries_unused`]).
+pub(super) const ENTRIES_RETRY: u64 = 8;
 
 /// Whether the solver gets a state for body `b`: awake and not static.
 #[inline]
