@@ -113,6 +113,13 @@ impl<T> Arena<T> {
     #[inline]
     pub fn get_mut(&mut self, index: u32, generation: u32) -> Option<&mut T> {
         self.writes += 1;
+        self.get_mut_quiet(index, generation)
+    }
+
+    /// [`Arena::get_mut`] without advancing [`Arena::writes`]: for a caller that records
+    /// the write itself.
+    #[inline]
+    pub fn get_mut_quiet(&mut self, index: u32, generation: u32) -> Option<&mut T> {
         let slot = self.slots.get_mut(index as usize)?;
         if slot.generation == generation {
             slot.value.as_mut()

@@ -604,18 +604,30 @@ impl World {
         // no body has been written since: what this pass would write is there already (a
         // read of every body record saved: large_pyramid's pass took 60 µs of a 3.3 ms
         // step on one thread, 30 µs of 2 ms on two).
+        // Bodies the API wrote are remade one by one, unless one of them changed whether
+        // it is solved (then the solver order changes: the whole pass).
         let made = self.next_entries.take();
+        let mut written = core::mem::take(&mut self.written_bodies);
         if let Some((_, _, loaded)) =
             made.filter(|&(writes, gravity, _)| writes == self.bodies.writes() && gravity == g)
         {
             if self.solver_bodies.len() == capacity {
-                self.any_load = loaded;
-                self.body_pass_skips += 1;
-                self.entries_writes = self.bodies.writes();
-                self.entries_unused = false;
-                return;
+                written.sort_unstable();
+                written.dedup();
+                if let Some(loaded) = self.remake_entries(&written, loaded, g) {
+                    self.any_load = loaded > 0;
+                    self.loaded_bodies = loaded;
+                    self.body_pass_skips += 1;
+                    self.entries_writes = self.bodies.writes();
+                    self.entries_unused = false;
+                    written.clear();
+                    self.written_bodies = written;
+                    return;
+                }
             }
         }
+        written.clear();
+        self.written_bodies = written;
         // Entries made for nothing (with none made, the last verdict stands).
         self.entries_unused |= made.is_some();
         self.entries_writes = self.bodies.writes();
@@ -632,7 +644,7 @@ impl World {
             self.sims.clear();
             self.states.push(BodyState::default()); // index 0: every static body
             self.sims.push(BodySim::default());
-            let mut loaded = false;
+            let mut loaded = 0;
             for (bi, (sb, flag)) in self
                 .solver_bodies
                 .iter_mut()
@@ -641,16 +653,47 @@ impl World {
             {
                 if let Some(b) = prepare_slot(self.bodies.at(bi as u32), self.states.len() as u32, sb, flag) {
                     let sim = body_sim(b, bi as u32, g);
-                    loaded |= loads(&sim);
+                    loaded += usize::from(loads(&sim));
                     self.states.push(body_state(b));
                     self.sims.push(sim);
                 }
             }
-            self.any_load = loaded;
+            self.loaded_bodies = loaded;
         }
+        self.any_load = self.loaded_bodies > 0;
         // Bodies whose contacts the narrow phase visits (awake and not static): most of
         // them, or few (see `World::collide`).
         self.mostly_awake = 2 * (self.states.len() - 1) > self.bodies.len();
+    }
+
+    /// What the body pass writes for the bodies in `written` (slot indices, sorted, no
+    /// repeats), in place: their solver entries, and their states and step data when they
+    /// are solved; `loaded`: the loaded bodies' count before. Returns the count after, or
+    /// `None` (nothing written) when some body's being solved changed, which moves the
+    /// solver indices of every body after it.
+    fn remake_entries(&mut self, written: &[u32], mut loaded: usize, g: Vec2) -> Option<usize> {
+        let solved_before = |bi: u32| self.scratch_flags.get(bi as usize).copied();
+        if written
+            .iter()
+            .any(|&bi| solved_before(bi) != Some(self.bodies.at(bi).is_some_and(solved)))
+        {
+            return None;
+        }
+        for &bi in written {
+            let (Some(b), Some(sb)) = (self.bodies.at(bi), self.solver_bodies.get_mut(bi as usize)) else {
+                continue;
+            };
+            let k = sb.index;
+            *sb = solver_body(Some(b), k);
+            if let (true, Some(state), Some(sim)) =
+                (k != 0, self.states.get_mut(k as usize), self.sims.get_mut(k as usize))
+            {
+                let new = body_sim(b, bi, g);
+                loaded = loaded - usize::from(loads(sim)) + usize::from(loads(&new));
+                (*state, *sim) = (body_state(b), new);
+            }
+        }
+        Some(loaded)
     }
 
     /// [`World::prepare_bodies`] on the pool's threads, with the same result: each chunk
@@ -710,30 +753,29 @@ impl World {
             .zip(shares)
             .zip(found.iter_mut())
             .enumerate();
-        let loaded = core::sync::atomic::AtomicBool::new(false);
+        let loaded = core::sync::atomic::AtomicUsize::new(0);
         claim_each(
             true,
             chunks,
             |(c, (((entries, flags), (first, states, sims)), found))| {
-                let (mut next, mut any) = (0usize, false);
+                let (mut next, mut any) = (0usize, 0usize);
                 for (k, (sb, flag)) in entries.iter_mut().zip(flags.iter_mut()).enumerate() {
                     let bi = c * BODY_CHUNK + k;
                     if let Some(b) = prepare_slot(bodies.at(bi as u32), (first + next) as u32, sb, flag) {
                         if let (Some(state), Some(sim)) = (states.get_mut(next), sims.get_mut(next)) {
                             *state = body_state(b);
                             *sim = body_sim(b, bi as u32, g);
-                            any |= loads(sim);
+                            any += usize::from(loads(sim));
                         }
                         next += 1;
                     }
                 }
                 *found = next;
-                if any {
-                    loaded.store(true, core::sync::atomic::Ordering::Relaxed);
-                }
+                // A sum: the same whatever the order the chunks finish in.
+                loaded.fetch_add(any, core::sync::atomic::Ordering::Relaxed);
             },
         );
-        self.any_load = loaded.into_inner();
+        self.loaded_bodies = loaded.into_inner();
         found
     }
 
@@ -801,7 +843,8 @@ impl World {
         // velocity in its solver entry (as the one-thread finalize, see there: with the
         // states reset below, the next step's entries when no body is written before it).
         use core::sync::atomic::{AtomicBool, Ordering::Relaxed};
-        let fresh = self.bodies.writes() == self.entries_writes && self.make_entries();
+        let fresh =
+            self.bodies.writes() == self.entries_writes && self.written_bodies.is_empty() && self.make_entries();
         let (states, sleep_on) = (&self.states, self.def.enable_sleep);
         let limit = self.def.max_linear_speed;
         let (any_fast, forced) = (AtomicBool::new(false), AtomicBool::new(false));
@@ -825,7 +868,7 @@ impl World {
             // Each state as `body_state` makes it from its body, whose velocity is now the
             // state's (a non-finite one is reported below: a write, so no skip).
             for_each_mut(parallel, &mut self.states[1..], BODY_CHUNK, |_, s| *s = next_state(s));
-            self.next_entries = Some((writes, self.def.gravity, self.any_load));
+            self.next_entries = Some((writes, self.def.gravity, self.loaded_bodies));
         }
         let mut touched = core::mem::take(&mut self.scratch_touched);
         self.touched_slots(any_fast.into_inner(), &mut touched);
@@ -897,8 +940,8 @@ impl World {
         // Only when no body was written since this step's entries were made: then only
         // what finalize writes (pose, velocity, the forces it clears) changes in them.
         let writes = self.bodies.writes();
-        let fresh = writes == self.entries_writes && self.make_entries();
-        let mut loaded = false;
+        let fresh = writes == self.entries_writes && self.written_bodies.is_empty() && self.make_entries();
+        let mut loaded = 0;
         for k in 1..self.states.len() {
             self.prefetch_finalize(k);
             let (bi, s) = (self.sims[k].body, self.states[k]);
@@ -915,7 +958,7 @@ impl World {
                 *state = body_state(b);
                 *sim = body_sim(b, bi, g);
                 (sb.center, sb.xf, sb.v, sb.w) = (b.center, b.xf, b.v, b.w);
-                loaded |= loads(sim);
+                loaded += usize::from(loads(sim));
             }
             let Some(bullet) = self.finite_or_reported(bi) else {
                 continue;
