@@ -600,37 +600,11 @@ impl World {
     fn prepare_bodies(&mut self, parallel: bool) {
         let g = self.def.gravity;
         let capacity = self.bodies.capacity();
-        // The last finalize made these entries from the records it had just written, and
-        // no body has been written since: what this pass would write is there already (a
-        // read of every body record saved: large_pyramid's pass took 60 µs of a 3.3 ms
-        // step on one thread, 30 µs of 2 ms on two).
-        // Bodies the API wrote are remade one by one, unless one of them changed whether
-        // it is solved (then the solver order changes: the whole pass).
-        let made = self.next_entries.take();
-        let mut written = core::mem::take(&mut self.written_bodies);
-        if let Some((_, _, loaded)) =
-            made.filter(|&(writes, gravity, _)| writes == self.bodies.writes() && gravity == g)
-        {
-            if self.solver_bodies.len() == capacity {
-                written.sort_unstable();
-                written.dedup();
-                if let Some(loaded) = self.remake_entries(&written, loaded, g) {
-                    self.any_load = loaded > 0;
-                    self.loaded_bodies = loaded;
-                    self.body_pass_skips += 1;
-                    self.entries_writes = self.bodies.writes();
-                    self.entries_unused = false;
-                    written.clear();
-                    self.written_bodies = written;
-                    return;
-                }
-            }
-        }
-        written.clear();
-        self.written_bodies = written;
-        // Entries made for nothing (with none made, the last verdict stands).
-        self.entries_unused |= made.is_some();
+        let reused = self.reuse_entries(g, capacity);
         self.entries_writes = self.bodies.writes();
+        if reused {
+            return;
+        }
         // Every entry is written below (an empty slot's too), so the arrays are only
         // resized, not cleared first: many_pyramids' 22 000 entries are 1.4 MB.
         self.solver_bodies.resize(capacity, SolverBody::default());
@@ -664,6 +638,35 @@ impl World {
         // Bodies whose contacts the narrow phase visits (awake and not static): most of
         // them, or few (see `World::collide`).
         self.mostly_awake = 2 * (self.states.len() - 1) > self.bodies.len();
+    }
+
+    /// Whether the entries the last finalize made stand for this step's body pass: no body
+    /// written since but through the API's `body_mut` (those are remade alone, unless one
+    /// changed whether it is solved: then the solver order changes) and the same gravity.
+    /// A read of every body record saved: large_pyramid's pass took 60 µs of a 3.3 ms step
+    /// on one thread, 30 µs of 2 ms on two. Clears the API's list of written bodies.
+    fn reuse_entries(&mut self, g: Vec2, capacity: usize) -> bool {
+        let made = self.next_entries.take();
+        let mut written = core::mem::take(&mut self.written_bodies);
+        written.sort_unstable();
+        written.dedup();
+        let loaded = made
+            .filter(|&(writes, gravity, _)| {
+                writes == self.bodies.writes() && gravity == g && self.solver_bodies.len() == capacity
+            })
+            .and_then(|(_, _, loaded)| self.remake_entries(&written, loaded, g));
+        written.clear();
+        self.written_bodies = written;
+        let Some(loaded) = loaded else {
+            // Entries made for nothing (with none made, the last verdict stands).
+            self.entries_unused |= made.is_some();
+            return false;
+        };
+        self.any_load = loaded > 0;
+        self.loaded_bodies = loaded;
+        self.body_pass_skips += 1;
+        self.entries_unused = false;
+        true
     }
 
     /// What the body pass writes for the bodies in `written` (slot indices, sorted, no
@@ -843,8 +846,7 @@ impl World {
         // velocity in its solver entry (as the one-thread finalize, see there: with the
         // states reset below, the next step's entries when no body is written before it).
         use core::sync::atomic::{AtomicBool, Ordering::Relaxed};
-        let fresh =
-            self.bodies.writes() == self.entries_writes && self.written_bodies.is_empty() && self.make_entries();
+        let fresh = self.make_entries();
         let (states, sleep_on) = (&self.states, self.def.enable_sleep);
         let limit = self.def.max_linear_speed;
         let (any_fast, forced) = (AtomicBool::new(false), AtomicBool::new(false));
@@ -859,7 +861,9 @@ impl World {
                     if advance_body(b, s, dt, sleep_on) && boxes_care(b, dt, limit) {
                         any_fast.store(true, Relaxed);
                     }
-                    (sb.center, sb.xf, sb.v, sb.w) = (b.center, b.xf, b.v, b.w);
+                    if fresh {
+                        move_entry(sb, b);
+                    }
                 }
             });
         // This pass's own writes are in the entries; any later one is not.
@@ -937,10 +941,8 @@ impl World {
         // as the next body pass would make them. Any other write to a body from here on
         // (a sweep moving one back, a report, sleep, the API) advances the count, and the
         // next step then runs its body pass.
-        // Only when no body was written since this step's entries were made: then only
-        // what finalize writes (pose, velocity, the forces it clears) changes in them.
         let writes = self.bodies.writes();
-        let fresh = writes == self.entries_writes && self.written_bodies.is_empty() && self.make_entries();
+        let fresh = self.make_entries();
         let mut loaded = 0;
         for k in 1..self.states.len() {
             self.prefetch_finalize(k);
@@ -957,7 +959,7 @@ impl World {
             ) {
                 *state = body_state(b);
                 *sim = body_sim(b, bi, g);
-                (sb.center, sb.xf, sb.v, sb.w) = (b.center, b.xf, b.v, b.w);
+                move_entry(sb, b);
                 loaded += usize::from(loads(sim));
             }
             let Some(bullet) = self.finite_or_reported(bi) else {
@@ -976,10 +978,14 @@ impl World {
     }
 
     /// Whether finalize makes the next step's entries (see [`World::finalize_one_thread`]):
-    /// not while the last ones went unused, but every [`ENTRIES_RETRY`] steps (whether
-    /// they are used changes no result, only the time).
+    /// only when no body was written since this step's entries were made (then only what
+    /// finalize writes, pose, velocity and the forces it clears, changes in them), and not
+    /// while the last ones went unused, but every [`ENTRIES_RETRY`] steps (whether they
+    /// are used changes no result, only the time).
     fn make_entries(&self) -> bool {
-        !self.entries_unused || self.step_count % ENTRIES_RETRY == 0
+        self.bodies.writes() == self.entries_writes
+            && self.written_bodies.is_empty()
+            && (!self.entries_unused || self.step_count % ENTRIES_RETRY == 0)
     }
 
     /// Whether body `bi` is a bullet, or `None` when its state went non-finite in this
@@ -1178,29 +1184,37 @@ fn solver_body(b: Option<&Body>, index: u32) -> SolverBody {
     }
 }
 
-/// The state of the step after one that ended with state `s` (its body's, when finalize
-/// has written `s`'s velocity into it: [`body_state`]'s).
+/// A solved body's state at the start of the step: velocity `v` [m/s], `w` [rad/s], no
+/// motion yet.
 #[inline]
-fn next_state(s: &BodyState) -> BodyState {
+fn start_state(v: Vec2, w: f32) -> BodyState {
     BodyState {
-        v: s.v,
-        w: s.w,
+        v,
+        w,
         touched: 0.0,
         dp: Vec2::ZERO,
         dq: Rot::IDENTITY,
     }
 }
 
-/// A solved body's state at the start of the step.
+/// Body `b`'s state at the start of the step.
 #[inline]
 fn body_state(b: &Body) -> BodyState {
-    BodyState {
-        v: b.v,
-        w: b.w,
-        touched: 0.0,
-        dp: Vec2::ZERO,
-        dq: Rot::IDENTITY,
-    }
+    start_state(b.v, b.w)
+}
+
+/// The state of the step after one that ended with state `s` (finalize has written `s`'s
+/// velocity into its body: [`body_state`]'s).
+#[inline]
+fn next_state(s: &BodyState) -> BodyState {
+    start_state(s.v, s.w)
+}
+
+/// What finalize changes in body `b`'s solver entry: its pose and velocity (the rest
+/// changes only with a write the next step sees, see [`World::make_entries`]).
+#[inline]
+fn move_entry(sb: &mut SolverBody, b: &Body) {
+    (sb.center, sb.xf, sb.v, sb.w) = (b.center, b.xf, b.v, b.w);
 }
 
 /// A solved body's step data (slot `bi`; `g`: the world's gravity [m/s²]).
