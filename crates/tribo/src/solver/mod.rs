@@ -480,6 +480,10 @@ pub(crate) struct SolverBody {
     /// Largest distance from the body origin to any of its shapes' points (bounded:
     /// `max_extent` + |local centre|) [m].
     pub reach: f32,
+    /// The body's sleep timer [s]: when the entry was made, and after each step's finalize
+    /// for a solved body (what the island pass reads, `World::update_sleep`, instead of
+    /// the body's record).
+    pub rest: f32,
 }
 
 const _: () = assert!(core::mem::size_of::<SolverBody>() == 64);

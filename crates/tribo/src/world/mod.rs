@@ -241,6 +241,9 @@ pub struct World {
     /// gravity are the same, the next body pass is not needed (see
     /// `World::prepare_bodies`).
     pub(crate) next_entries: Option<(u64, Vec2, usize)>,
+    /// Some solved dynamic body ended the last finalize with its sleep timer at the time to
+    /// sleep: only then may an island fall asleep (`World::update_sleep`).
+    pub(crate) any_rested: bool,
     /// Bodies the API wrote through `body_mut` since the last body pass (slot indices, in
     /// call order, repeats kept): not counted by the bodies' write count, but remade one by
     /// one when the pass is skipped.
@@ -327,6 +330,7 @@ impl World {
             scratch_chunk_counts: Vec::new(),
             body_pass_retries: 0,
             next_entries: None,
+            any_rested: false,
             written_bodies: Vec::new(),
             loaded_bodies: 0,
             body_pass_skips: 0,

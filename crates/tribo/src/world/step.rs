@@ -849,7 +849,8 @@ impl World {
         let fresh = self.make_entries();
         let (states, sleep_on) = (&self.states, self.def.enable_sleep);
         let limit = self.def.max_linear_speed;
-        let (any_fast, forced) = (AtomicBool::new(false), AtomicBool::new(false));
+        let tts = self.def.time_to_sleep;
+        let (any_fast, forced, rested) = (AtomicBool::new(false), AtomicBool::new(false), AtomicBool::new(false));
         self.bodies
             .for_each_live_mut_with(parallel, BODY_CHUNK, &mut self.solver_bodies, |_, b, sb| {
                 let index = sb.index;
@@ -861,11 +862,16 @@ impl World {
                     if advance_body(b, s, dt, sleep_on) && boxes_care(b, dt, limit) {
                         any_fast.store(true, Relaxed);
                     }
+                    sb.rest = b.sleep_time;
+                    if rests(b, tts) {
+                        rested.store(true, Relaxed);
+                    }
                     if fresh {
                         move_entry(sb, b);
                     }
                 }
             });
+        self.any_rested = rested.into_inner();
         // This pass's own writes are in the entries; any later one is not.
         let writes = self.bodies.writes();
         if fresh && !forced.into_inner() {
@@ -943,7 +949,7 @@ impl World {
         // next step then runs its body pass.
         let writes = self.bodies.writes();
         let fresh = self.make_entries();
-        let mut loaded = 0;
+        let (mut loaded, mut rested, tts) = (0, false, self.def.time_to_sleep);
         for k in 1..self.states.len() {
             self.prefetch_finalize(k);
             let (bi, s) = (self.sims[k].body, self.states[k]);
@@ -951,6 +957,10 @@ impl World {
                 continue;
             };
             let care = advance_body(b, s, dt, sleep_on) && boxes_care(b, dt, limit);
+            rested |= rests(b, tts);
+            if let Some(sb) = self.solver_bodies.get_mut(bi as usize) {
+                sb.rest = b.sleep_time;
+            }
             if let (true, Some(state), Some(sim), Some(sb)) = (
                 fresh,
                 self.states.get_mut(k),
@@ -974,6 +984,7 @@ impl World {
             self.refresh_body_proxies(bi, dt, sweep);
         }
         self.scratch_touched = touched;
+        self.any_rested = rested;
         self.next_entries = fresh.then_some((writes, g, loaded));
     }
 
@@ -1045,21 +1056,17 @@ impl World {
             return;
         }
         // An island falls asleep when its least rested body has rested `time_to_sleep`: while
-        // no awake body has, no island can, and the islands need not be built (a pile that
-        // keeps moving, like the tumbler's, pays one pass over the bodies).
+        // no awake body has, no island can, and the islands need not be built (finalize
+        // finds whether one has while it writes the timers: a pile that keeps moving, like
+        // the tumbler's, pays nothing here).
         let tts = self.def.time_to_sleep;
-        if !self
-            .bodies
-            .iter()
-            .any(|(_, b)| b.awake && b.is_dynamic() && b.sleep_time >= tts)
-        {
+        if !self.any_rested {
             return;
         }
         // Islands over the solver slots of the awake bodies (solver order is slot order, so
         // an island's smallest solver slot belongs to its smallest body slot, and the
         // islands come out in the same order as over body slots).
         let n = self.states.len();
-        let slot = |bi: u32| self.solver_bodies.get(bi as usize).map_or(0, |sb| sb.index);
         let mut parent = core::mem::take(&mut self.scratch_u32);
         parent.clear();
         parent.extend(0..n as u32);
@@ -1090,13 +1097,17 @@ impl World {
                 }
             }
         }
+        // The bodies' entries say which are awake and dynamic (as their records do: the
+        // entries are made again when collide wakes a body, and nothing after it wakes or
+        // puts one to sleep) and hold their timers as finalize left them: one line per body
+        // slot is read, not the records (the joints' bodies at random, then every body
+        // twice: most of this pass in rain's 11 000 ragdoll bodies).
+        let entries = &self.solver_bodies;
+        let awake_dynamic = |bi: u32| entries.get(bi as usize).filter(|sb| sb.awake_dynamic);
         // Joints between awake dynamic bodies.
         for (_, j) in self.joints.iter() {
-            let (Some(a), Some(b)) = (self.bodies.at(j.body_a), self.bodies.at(j.body_b)) else {
-                continue;
-            };
-            if a.is_dynamic() && b.is_dynamic() && a.awake && b.awake {
-                let (sa, sb) = (slot(j.body_a), slot(j.body_b));
+            if let (Some(a), Some(b)) = (awake_dynamic(j.body_a), awake_dynamic(j.body_b)) {
+                let (sa, sb) = (a.index, b.index);
                 if sa != 0 && sb != 0 && (sa as usize) < n && (sb as usize) < n {
                     union(&mut parent, sa, sb);
                 }
@@ -1106,22 +1117,20 @@ impl World {
         min_time.clear();
         min_time.resize(n, f32::INFINITY);
         let mut any = false;
-        for (bi, b) in self.bodies.iter() {
-            if b.awake && b.is_dynamic() {
-                let r = find(&mut parent, slot(bi)) as usize;
-                min_time[r] = min_time[r].min(b.sleep_time);
-                any = true;
-            }
+        // Body slot order (the records' order before).
+        let solved = || entries.iter().enumerate().filter(|(_, sb)| sb.awake_dynamic);
+        for (_, sb) in solved() {
+            let r = find(&mut parent, sb.index) as usize;
+            min_time[r] = min_time[r].min(sb.rest);
+            any = true;
         }
         if any {
             let mut islands: Vec<(u32, Vec<u32>)> = Vec::new();
             let mut members_of_root: std::collections::BTreeMap<u32, Vec<u32>> = Default::default();
-            for (bi, b) in self.bodies.iter() {
-                if b.awake && b.is_dynamic() {
-                    let r = find(&mut parent, slot(bi));
-                    if min_time[r as usize] >= tts {
-                        members_of_root.entry(r).or_default().push(bi);
-                    }
+            for (bi, sb) in solved() {
+                let r = find(&mut parent, sb.index);
+                if min_time[r as usize] >= tts {
+                    members_of_root.entry(r).or_default().push(bi as u32);
                 }
             }
             islands.extend(members_of_root);
@@ -1181,6 +1190,7 @@ fn solver_body(b: Option<&Body>, index: u32) -> SolverBody {
         w: b.w,
         max_extent: b.max_extent,
         reach: b.max_extent + b.local_center.length(),
+        rest: b.sleep_time,
     }
 }
 
@@ -1341,6 +1351,13 @@ fn advance_body(b: &mut Body, s: BodyState, dt: f32, sleep_on: bool) -> bool {
         b.sleep_time = 0.0;
     }
     true
+}
+
+/// Whether a solved body has rested long enough to sleep (`tts`: the world's time to
+/// sleep [s]); its island may then fall asleep ([`World::update_sleep`]).
+#[inline]
+fn rests(b: &Body, tts: f32) -> bool {
+    b.is_dynamic() && b.sleep_time >= tts
 }
 
 /// Whether a body's boxes depend on the sweep rule: it moved this step, or will move at
