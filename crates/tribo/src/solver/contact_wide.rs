@@ -385,8 +385,8 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
 /// where half the lanes bounce.
 pub(crate) fn restitution<S: StateCell>(h: &mut WideHead, w: &mut WideContact, cold: &WideCold, states: &[S]) {
     let zero = F4::ZERO;
-    let e = F4(cold.restitution);
-    let minus_threshold = -F4(cold.restitution_threshold);
+    let e = F4::new(cold.restitution);
+    let minus_threshold = -F4::new(cold.restitution_threshold);
     // `contact_solver::bounces` of each point (absent points never bounce).
     let bounces: [M4; 2] = core::array::from_fn(|i| {
         let p = &w.points[i];
@@ -469,7 +469,7 @@ pub(crate) fn restitution<S: StateCell>(h: &mut WideHead, w: &mut WideContact, c
         // The energy cap: λ ≤ m_n (−vn + √(vn² + 2 room / m_n)), room = KE₀ − KE.
         let capped = impulse.gt(zero) & normal_mass.gt(zero);
         if (capped & m).any() {
-            let room = F4(cold.kinetic_energy) - kinetic_energy(h, &a, &b);
+            let room = F4::new(cold.kinetic_energy) - kinetic_energy(h, &a, &b);
             let disc = vn * vn + F4::splat(2.0) * room / normal_mass;
             let max = disc.gt(zero).select(normal_mass * (-vn + disc.sqrt()), zero);
             impulse = capped.select(impulse.min(max.max(zero)), impulse);
@@ -741,7 +741,7 @@ pub(crate) fn build_group<S: StateRead>(
     // clearing included: a fifth of the build's samples; the build and its `memset`s went
     // from 11.2 % to 10.7 % of large_pyramid's step.
     let each = |f: &dyn Fn(&ContactInput, &ConstraintBodies) -> f32| {
-        F4(core::array::from_fn(|l| {
+        F4::new(core::array::from_fn(|l| {
             lanes[l].map_or(0.0, |(_, input, b)| f(input, b))
         }))
     };
@@ -751,7 +751,7 @@ pub(crate) fn build_group<S: StateRead>(
     // of sixteen single-lane loads and inserts per row.
     let columns = |row: &dyn Fn(&ContactInput, &ConstraintBodies) -> [f32; LANES]| {
         transpose(core::array::from_fn(|l| {
-            F4(lanes[l].map_or([0.0; LANES], |(_, input, b)| row(input, b)))
+            F4::new(lanes[l].map_or([0.0; LANES], |(_, input, b)| row(input, b)))
         }))
     };
     let [cax, cay, cbx, cby] = columns(&|_, b| b.centre_row());
@@ -797,9 +797,9 @@ pub(crate) fn build_group<S: StateRead>(
             _ => t(0) + t(1),
         }
     });
-    c.base_drift = base_drift.map(|d| d.0);
+    c.base_drift = base_drift.map(|d| *d);
     let [mu_s, mu_d, restitution, threshold] = columns(&|input, _| input.material_row());
-    (c.mu_s, c.mu_d, c.restitution, c.restitution_threshold) = (mu_s.0, mu_d.0, restitution.0, threshold.0);
+    (c.mu_s, c.mu_d, c.restitution, c.restitution_threshold) = (*mu_s, *mu_d, *restitution, *threshold);
     let [rolling_resistance, tangent_speed, rolling_impulse, _] = columns(&|input, _| input.surface_row());
     (out.rolling_resistance, out.tangent_speed) = (rolling_resistance, tangent_speed);
     if warm {
@@ -808,7 +808,7 @@ pub(crate) fn build_group<S: StateRead>(
     for (l, lane) in lanes.iter().enumerate() {
         let Some((contact, input, b)) = *lane else {
             // An empty lane: nothing but a sticking, empty friction row.
-            out.stick.0[l] = u32::MAX;
+            out.stick[l] = u32::MAX;
             continue;
         };
         let count = count_of(input);
@@ -836,7 +836,7 @@ pub(crate) fn build_group<S: StateRead>(
         for (i, ip) in input.points[..count].iter().enumerate() {
             let wp = &mut out.points[i];
             if warm {
-                wp.preload.0[l] = ip.preload;
+                wp.preload[l] = ip.preload;
             }
             let stick = match states_ab {
                 Some((sa, sb)) if ip.fresh => {
@@ -849,7 +849,7 @@ pub(crate) fn build_group<S: StateRead>(
             c.fresh[i][l] = ip.fresh;
             row_stick &= stick;
         }
-        out.stick.0[l] = if row_stick { u32::MAX } else { 0 };
+        out.stick[l] = if row_stick { u32::MAX } else { 0 };
     }
     // μs where the row sticks (an empty lane: 0), μd where it slides.
     out.mu = out.stick.select(mu_s, mu_d);
@@ -977,15 +977,15 @@ pub(crate) fn store_group<S: StateRead>(
     };
     let (n0, n1) = (h.points[0].normal_impulse, h.points[1].normal_impulse);
     let (sum_t, sum_n) = (sum_over(tangent, tangent), sum_over(n0, n1));
-    let patch_saturated = sum_t.abs().ge(F4::splat(0.999) * F4(cold.mu_s) * sum_n) & has0 & w.saturated;
+    let patch_saturated = sum_t.abs().ge(F4::splat(0.999) * F4::new(cold.mu_s) * sum_n) & has0 & w.saturated;
     // Only read where there are two points (`Sum` from −0.0: the plain sum of the two).
     let sum_total_t = total_tangent + total_tangent;
     let (tn0, tn1) = (w.points[0].total_normal_impulse, w.points[1].total_normal_impulse);
     let sum_total_n = tn0 + tn1;
     let stick_speed = F4::splat(ctx.stick_speed);
-    let restitution = F4(cold.restitution);
-    let threshold = -F4(cold.restitution_threshold);
-    for (o, (&count, &rolling)) in out.iter_mut().zip(cold.count.iter().zip(&h.rolling_impulse.0)) {
+    let restitution = F4::new(cold.restitution);
+    let threshold = -F4::new(cold.restitution_threshold);
+    for (o, (&count, &rolling)) in out.iter_mut().zip(cold.count.iter().zip(h.rolling_impulse.iter())) {
         o.count = count.min(2);
         o.rolling_impulse = rolling;
     }
@@ -1003,7 +1003,7 @@ pub(crate) fn store_group<S: StateRead>(
         let total_tangent_out =
             (two & sum_total_n.gt(zero)).select(sum_total_t * total_normal / sum_total_n, total_tangent);
         let drift = (stick & was_stick & loaded).select(
-            disp[i] + F4(cold.base_drift[i]) - w.tangent_speed * F4::splat(ctx.dt),
+            disp[i] + F4::new(cold.base_drift[i]) - w.tangent_speed * F4::splat(ctx.dt),
             zero,
         );
         // next_preload, with `bounces` of the restitution pass.
@@ -1014,20 +1014,20 @@ pub(crate) fn store_group<S: StateRead>(
         let preload = released.select(zero, fresh.select(normal, kept));
         for (l, o) in out.iter_mut().enumerate() {
             o.points[i] = PointState {
-                normal_impulse: normal.0[l],
-                tangent_impulse: tangent.0[l],
-                total_normal_impulse: total_normal.0[l],
-                total_tangent_impulse: total_tangent_out.0[l],
-                max_normal_impulse: max.0[l],
+                normal_impulse: normal[l],
+                tangent_impulse: tangent[l],
+                total_normal_impulse: total_normal[l],
+                total_tangent_impulse: total_tangent_out[l],
+                max_normal_impulse: max[l],
                 state: if stick.lane(l) {
                     FrictionState::Stick
                 } else {
                     FrictionState::Slip
                 },
                 fresh: false,
-                drift: drift.0[l],
-                slip_speed: slip_speed.0[l],
-                preload: preload.0[l],
+                drift: drift[l],
+                slip_speed: slip_speed[l],
+                preload: preload[l],
             };
         }
     }
@@ -1061,30 +1061,30 @@ pub(crate) fn pack(
     h.index_b[l] = cc.index_b;
     h.write_a[l] = dynamic_a && cc.index_a != 0;
     h.write_b[l] = dynamic_b && cc.index_b != 0;
-    h.normal.x.0[l] = cc.normal.x;
-    h.normal.y.0[l] = cc.normal.y;
-    h.inv_mass_a.0[l] = cc.inv_mass_a;
-    h.inv_i_a.0[l] = cc.inv_i_a;
-    h.inv_mass_b.0[l] = cc.inv_mass_b;
-    h.inv_i_b.0[l] = cc.inv_i_b;
-    h.split.0[l] = cc.split;
-    h.shift_cap2.0[l] = cc.shift_cap2;
+    h.normal.x[l] = cc.normal.x;
+    h.normal.y[l] = cc.normal.y;
+    h.inv_mass_a[l] = cc.inv_mass_a;
+    h.inv_i_a[l] = cc.inv_i_a;
+    h.inv_mass_b[l] = cc.inv_mass_b;
+    h.inv_i_b[l] = cc.inv_i_b;
+    h.split[l] = cc.split;
+    h.shift_cap2[l] = cc.shift_cap2;
     cold.mu_s[l] = cc.mu_s;
     cold.mu_d[l] = cc.mu_d;
-    w.tangent_speed.0[l] = cc.tangent_speed;
-    w.rolling_resistance.0[l] = cc.rolling_resistance;
+    w.tangent_speed[l] = cc.tangent_speed;
+    w.rolling_resistance[l] = cc.rolling_resistance;
     h.any_rolling |= cc.rolling_resistance > 0.0 || cc.rolling_impulse != 0.0;
     for i in 0..2 {
         let (hp, wp) = (&mut h.points[i], &mut w.points[i]);
         if i < cc.count {
             let cp = &cc.points[i];
-            hp.r_a.x.0[l] = cp.r_a.x;
-            hp.r_a.y.0[l] = cp.r_a.y;
-            hp.r_b.x.0[l] = cp.r_b.x;
-            hp.r_b.y.0[l] = cp.r_b.y;
-            wp.base_separation.0[l] = cp.base_separation;
-            wp.normal_mass.0[l] = cp.normal_mass;
-            wp.preload.0[l] = cp.preload;
+            hp.r_a.x[l] = cp.r_a.x;
+            hp.r_a.y[l] = cp.r_a.y;
+            hp.r_b.x[l] = cp.r_b.x;
+            hp.r_b.y[l] = cp.r_b.y;
+            wp.base_separation[l] = cp.base_separation;
+            wp.normal_mass[l] = cp.normal_mass;
+            wp.preload[l] = cp.preload;
         } else {
             // A point that does nothing: no mass, no anchors, no impulse (every product
             // with its zero mass stays finite and zero).
@@ -1097,17 +1097,17 @@ pub(crate) fn pack(
                 &mut wp.preload,
                 &mut wp.base_separation,
             ] {
-                f.0[l] = 0.0;
+                f[l] = 0.0;
             }
         }
     }
     let block = cc.count == 2 && cc.block;
     let k = if block { cc.k } else { [0.0; 3] };
-    w.k11.0[l] = k[0];
-    w.k12.0[l] = k[1];
-    w.k22.0[l] = k[2];
-    w.inv_det.0[l] = if block { cc.inv_det } else { 0.0 };
-    w.block.0[l] = if block { u32::MAX } else { 0 };
+    w.k11[l] = k[0];
+    w.k12[l] = k[1];
+    w.k22[l] = k[2];
+    w.inv_det[l] = if block { cc.inv_det } else { 0.0 };
+    w.block[l] = if block { u32::MAX } else { 0 };
     let (p0, p1) = (&cc.points[0], &cc.points[1]);
     // The friction row's anchors follow from the points' (`friction_arms`).
     let (tm, drift, stick) = match cc.count {
@@ -1119,11 +1119,11 @@ pub(crate) fn pack(
         1 => (p0.tangent_mass, p0.base_drift, p0.stick),
         _ => (0.0, 0.0, true),
     };
-    w.tangent_mass.0[l] = tm;
-    w.base_drift.0[l] = drift;
-    w.stick.0[l] = if stick { u32::MAX } else { 0 };
-    w.mu.0[l] = if stick { cc.mu_s } else { cc.mu_d };
-    h.two_points.0[l] = if cc.count == 2 { u32::MAX } else { 0 };
+    w.tangent_mass[l] = tm;
+    w.base_drift[l] = drift;
+    w.stick[l] = if stick { u32::MAX } else { 0 };
+    w.mu[l] = if stick { cc.mu_s } else { cc.mu_d };
+    h.two_points[l] = if cc.count == 2 { u32::MAX } else { 0 };
     pack_state(h, w, l, cc);
 }
 
@@ -1143,19 +1143,19 @@ pub(crate) fn pack_state(h: &mut WideHead, w: &mut WideContact, l: usize, cc: &C
         } else {
             (0.0, 0.0, 0.0, 0.0, 0.0)
         };
-        h.points[i].normal_impulse.0[l] = lam;
-        wp.total_normal_impulse.0[l] = total;
-        wp.max_normal_impulse.0[l] = max;
-        wp.approach.0[l] = approach;
-        h.points[i].substep_vn.0[l] = vn;
+        h.points[i].normal_impulse[l] = lam;
+        wp.total_normal_impulse[l] = total;
+        wp.max_normal_impulse[l] = max;
+        wp.approach[l] = approach;
+        h.points[i].substep_vn[l] = vn;
     }
     let n = cc.count.min(2);
     let sum_t: f32 = cc.points[..n].iter().map(|p| p.tangent_impulse).sum();
     let sum_total_t: f32 = cc.points[..n].iter().map(|p| p.total_tangent_impulse).sum();
-    h.tangent_impulse.0[l] = sum_t;
-    w.total_tangent_impulse.0[l] = sum_total_t;
-    w.saturated.0[l] = if cc.points[0].saturated { u32::MAX } else { 0 };
-    h.rolling_impulse.0[l] = cc.rolling_impulse;
+    h.tangent_impulse[l] = sum_t;
+    w.total_tangent_impulse[l] = sum_total_t;
+    w.saturated[l] = if cc.points[0].saturated { u32::MAX } else { 0 };
+    h.rolling_impulse[l] = cc.rolling_impulse;
 }
 
 /// Copies lane `l`'s changing parts back into the scalar constraint.
@@ -1166,16 +1166,16 @@ pub(crate) fn unpack_state(h: &WideHead, w: &WideContact, l: usize, cc: &mut Con
     for i in 0..count {
         let wp = &w.points[i];
         let cp = &mut cc.points[i];
-        cp.normal_impulse = h.points[i].normal_impulse.0[l];
-        cp.total_normal_impulse = wp.total_normal_impulse.0[l];
-        cp.max_normal_impulse = wp.max_normal_impulse.0[l];
-        cp.approach = wp.approach.0[l];
-        cp.substep_vn = h.points[i].substep_vn.0[l];
-        cp.tangent_impulse = share * h.tangent_impulse.0[l];
-        cp.total_tangent_impulse = share * w.total_tangent_impulse.0[l];
+        cp.normal_impulse = h.points[i].normal_impulse[l];
+        cp.total_normal_impulse = wp.total_normal_impulse[l];
+        cp.max_normal_impulse = wp.max_normal_impulse[l];
+        cp.approach = wp.approach[l];
+        cp.substep_vn = h.points[i].substep_vn[l];
+        cp.tangent_impulse = share * h.tangent_impulse[l];
+        cp.total_tangent_impulse = share * w.total_tangent_impulse[l];
         cp.saturated = saturated;
     }
-    cc.rolling_impulse = h.rolling_impulse.0[l];
+    cc.rolling_impulse = h.rolling_impulse[l];
 }
 
 /// Rebuilds the scalar constraint of lane `l` (geometry, masses and current state).
@@ -1193,36 +1193,36 @@ pub(crate) fn unpack_full(
     } else {
         soft.contact
     };
-    let k_roll = h.inv_i_a.0[l] + h.inv_i_b.0[l];
+    let k_roll = h.inv_i_a[l] + h.inv_i_b[l];
     let mut cc = ContactConstraint {
         index_a: h.index_a[l],
         index_b: h.index_b[l],
         contact: cold.contact[l],
-        normal: Vec2::new(h.normal.x.0[l], h.normal.y.0[l]),
-        inv_mass_a: h.inv_mass_a.0[l],
-        inv_i_a: h.inv_i_a.0[l],
-        inv_mass_b: h.inv_mass_b.0[l],
-        inv_i_b: h.inv_i_b.0[l],
+        normal: Vec2::new(h.normal.x[l], h.normal.y[l]),
+        inv_mass_a: h.inv_mass_a[l],
+        inv_i_a: h.inv_i_a[l],
+        inv_mass_b: h.inv_mass_b[l],
+        inv_i_b: h.inv_i_b[l],
         mu_s: cold.mu_s[l],
         mu_d: cold.mu_d[l],
         restitution: cold.restitution[l],
         restitution_threshold: cold.restitution_threshold[l],
-        rolling_resistance: w.rolling_resistance.0[l],
+        rolling_resistance: w.rolling_resistance[l],
         rolling_mass: if k_roll > 0.0 { 1.0 / k_roll } else { 0.0 },
         rolling_impulse: 0.0,
-        tangent_speed: w.tangent_speed.0[l],
+        tangent_speed: w.tangent_speed[l],
         k: if block {
-            [w.k11.0[l], w.k12.0[l], w.k22.0[l]]
+            [w.k11[l], w.k12[l], w.k22[l]]
         } else {
             [0.0; 3]
         },
-        inv_det: if block { w.inv_det.0[l] } else { 0.0 },
+        inv_det: if block { w.inv_det[l] } else { 0.0 },
         block,
-        split: h.split.0[l],
-        shift_cap2: h.shift_cap2.0[l],
+        split: h.split[l],
+        shift_cap2: h.shift_cap2[l],
         kinetic_energy: cold.kinetic_energy[l],
         height: cold.height[l],
-        patch_tangent_mass: if count == 2 { w.tangent_mass.0[l] } else { 0.0 },
+        patch_tangent_mass: if count == 2 { w.tangent_mass[l] } else { 0.0 },
         count,
         points: [ConstraintPoint::default(); 2],
     };
@@ -1230,13 +1230,13 @@ pub(crate) fn unpack_full(
         let wp = &w.points[i];
         let cp = &mut cc.points[i];
         let hp = &h.points[i];
-        cp.r_a = Vec2::new(hp.r_a.x.0[l], hp.r_a.y.0[l]);
-        cp.r_b = Vec2::new(hp.r_b.x.0[l], hp.r_b.y.0[l]);
-        cp.base_separation = wp.base_separation.0[l];
+        cp.r_a = Vec2::new(hp.r_a.x[l], hp.r_a.y[l]);
+        cp.r_b = Vec2::new(hp.r_b.x[l], hp.r_b.y[l]);
+        cp.base_separation = wp.base_separation[l];
         cp.base_drift = cold.base_drift[i][l];
-        cp.normal_mass = wp.normal_mass.0[l];
-        cp.tangent_mass = if count == 1 { w.tangent_mass.0[l] } else { 0.0 };
-        cp.preload = wp.preload.0[l];
+        cp.normal_mass = wp.normal_mass[l];
+        cp.tangent_mass = if count == 1 { w.tangent_mass[l] } else { 0.0 };
+        cp.preload = wp.preload[l];
         cp.soft = soft;
         cp.stick = cold.stick[i][l];
         cp.fresh = cold.fresh[i][l];
@@ -1400,7 +1400,7 @@ mod tests {
         // slipping slides; the empty lane carries no mass.
         assert!(cold.stick[0][0] && !cold.stick[0][1] && cold.fresh[0][1]);
         assert_eq!(
-            (h.inv_mass_a.0[3], h.inv_mass_b.0[3], w.points[0].normal_mass.0[3]),
+            (h.inv_mass_a[3], h.inv_mass_b[3], w.points[0].normal_mass[3]),
             (0.0, 0.0, 0.0)
         );
         assert!(h.any_rolling && cold.any_restitution && w.block.lane(0));
@@ -1453,16 +1453,16 @@ mod tests {
             for (l, cc) in scalar.iter().enumerate() {
                 let p = &cc.points[0];
                 assert_eq!(
-                    h.points[0].normal_impulse.0[l].to_bits(),
+                    h.points[0].normal_impulse[l].to_bits(),
                     p.normal_impulse.to_bits(),
                     "pass {pass} lane {l}"
                 );
                 assert_eq!(
-                    h.tangent_impulse.0[l].to_bits(),
+                    h.tangent_impulse[l].to_bits(),
                     p.tangent_impulse.to_bits(),
                     "pass {pass} lane {l}"
                 );
-                assert_eq!(h.points[1].normal_impulse.0[l].to_bits(), 0, "no second point");
+                assert_eq!(h.points[1].normal_impulse[l].to_bits(), 0, "no second point");
                 loaded |= p.normal_impulse > 0.0;
             }
             let bits =
@@ -1550,9 +1550,9 @@ mod tests {
             .into_iter()
             .enumerate()
         {
-            w.points[i].approach = F4(approach);
-            w.points[i].max_normal_impulse = F4([1.0, 1.0, 1.0, 0.0]);
-            w.points[i].total_normal_impulse = F4([0.3, 0.2, 0.1, 0.0]);
+            w.points[i].approach = F4::new(approach);
+            w.points[i].max_normal_impulse = F4::new([1.0, 1.0, 1.0, 0.0]);
+            w.points[i].total_normal_impulse = F4::new([0.3, 0.2, 0.1, 0.0]);
         }
         cold.kinetic_energy = [50.0, 0.2, 50.0, 0.0];
         assert!(w.block.lane(0), "lane 0 is a face the block can solve");
@@ -1583,16 +1583,16 @@ mod tests {
         // The cases do what they claim: lane 0's two points and lane 2's first point take
         // new impulses, lane 2's second keeps its own; lane 1's rebound is cut by the cap
         // (it rebounds more when the pair had energy to spare).
-        let changed = |l: usize, i: usize| h.points[i].normal_impulse.0[l] != before.0.points[i].normal_impulse.0[l];
+        let changed = |l: usize, i: usize| h.points[i].normal_impulse[l] != before.0.points[i].normal_impulse[l];
         assert!(changed(0, 0) && changed(0, 1) && changed(2, 0) && !changed(2, 1) && changed(1, 0));
         let (mut free_h, mut free_w, mut free_cold) = (before.0, before.1, cold);
         free_cold.kinetic_energy[1] = 1e6;
         let fresh: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
         restitution(&mut free_h, &mut free_w, &free_cold, &fresh);
-        let lam = before.0.points[0].normal_impulse.0[1];
+        let lam = before.0.points[0].normal_impulse[1];
         let (capped, free) = (
-            h.points[0].normal_impulse.0[1] - lam,
-            free_h.points[0].normal_impulse.0[1] - lam,
+            h.points[0].normal_impulse[1] - lam,
+            free_h.points[0].normal_impulse[1] - lam,
         );
         assert!(
             0.0 < capped && capped < 0.9 * free,

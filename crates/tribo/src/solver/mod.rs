@@ -124,18 +124,9 @@ fn write_velocity_row(p: *mut BodyState, row: wide::F4) {
     // SAFETY: `p` points to a live, aligned BodyState only this thread touches now (the
     // caller's own cell, see [`SharedState`]'s contract); its first 16 bytes are v, w and
     // touched as f32 (checked below).
+    // One vector store on x86-64 (an `F4` is a register there).
     unsafe {
-        // One vector store (storing the F4 array is four scalar stores after LLVM's
-        // scalar replacement).
-        #[cfg(target_arch = "x86_64")]
-        core::arch::x86_64::_mm_store_ps(
-            p as *mut f32,
-            core::arch::x86_64::_mm_setr_ps(row.0[0], row.0[1], row.0[2], row.0[3]),
-        );
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            *(p as *mut wide::F4) = row;
-        }
+        *(p as *mut wide::F4) = row;
     }
 }
 const _: () = {
@@ -983,14 +974,14 @@ pub(crate) fn integrate_positions_range<S: StateCell>(
             let da = h * s.w.clamp(-max_w, max_w);
             (s.dq.c - da * s.dq.s, s.dq.s + da * s.dq.c)
         });
-        let (c, sn) = (wide::F4(turned.map(|t| t.0)), wide::F4(turned.map(|t| t.1)));
+        let (c, sn) = (wide::F4::new(turned.map(|t| t.0)), wide::F4::new(turned.map(|t| t.1)));
         let mag = (c * c + sn * sn).sqrt();
         let zero = wide::F4::ZERO;
         let inv = mag.gt(zero).select(wide::F4::splat(1.0) / mag, zero);
         let (qc, qs) = (c * inv, sn * inv);
         for (l, (state, sim)) in block.iter().zip(block_sims).enumerate() {
             let mut s = integrate_translation(ctx, sim, state.get());
-            s.dq = crate::math::Rot { c: qc.0[l], s: qs.0[l] };
+            s.dq = crate::math::Rot { c: qc[l], s: qs[l] };
             state.set(s);
         }
         k += wide::LANES;

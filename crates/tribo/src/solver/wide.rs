@@ -2,9 +2,10 @@
 //!
 //! `F4` is four `f32` lanes; every operation is lane-wise plain IEEE arithmetic (no fused
 //! multiply-add, no approximate reciprocal), so a lane computes bit for bit what the same
-//! scalar expression computes. On x86-64 every operation is one SSE instruction (safe
-//! intrinsics of the baseline target; the lanes move in and out of registers with
-//! `setr`/shuffles, which LLVM turns into plain vector loads and stores). Elsewhere the
+//! scalar expression computes. On x86-64 a lane vector is an SSE register (`__m128`) and
+//! every operation one SSE instruction (safe intrinsics of the baseline target); its lanes
+//! are read and written as an array through `Deref` (the sixth `unsafe` site: a register's
+//! bytes seen as four lanes). Elsewhere the
 //! lane loops are left to LLVM's vectorizer, which on x86-64 turned the selects of
 //! compare results back into per-lane branches (Box2D's SIMD solver writes intrinsics for
 //! the same reason). Masks are lanes of all-ones / all-zeros bits, like SIMD compare
@@ -15,15 +16,188 @@ use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub, SubAssig
 /// Lanes per wide constraint.
 pub(crate) const LANES: usize = 4;
 
-/// Four `f32` lanes.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-#[repr(C, align(16))]
-pub(crate) struct F4(pub [f32; LANES]);
+/// The register a lane vector lives in: an SSE register on x86-64 (so LLVM keeps it whole
+/// where branches meet, instead of taking a four-`f32` array apart into scalars there and
+/// packing it again: ~80 instructions per group of the biased solve pass, found with
+/// llvm-mca), else an array.
+#[cfg(target_arch = "x86_64")]
+type Raw = core::arch::x86_64::__m128;
+#[cfg(not(target_arch = "x86_64"))]
+type RawF = [f32; LANES];
+#[cfg(not(target_arch = "x86_64"))]
+type RawM = [u32; LANES];
+#[cfg(target_arch = "x86_64")]
+type RawF = Raw;
+#[cfg(target_arch = "x86_64")]
+type RawM = Raw;
 
-/// Four lane masks (each all ones = true or all zeros = false).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// Four `f32` lanes (read and written as an array through `Deref`).
+#[derive(Clone, Copy)]
 #[repr(C, align(16))]
-pub(crate) struct M4(pub [u32; LANES]);
+pub(crate) struct F4(RawF);
+
+/// Four lane masks (each all ones = true or all zeros = false; read and written as an
+/// array of `u32` through `Deref`).
+#[derive(Clone, Copy)]
+#[repr(C, align(16))]
+pub(crate) struct M4(RawM);
+
+const _: () = assert!(core::mem::size_of::<F4>() == 16 && core::mem::size_of::<M4>() == 16);
+
+impl core::ops::Deref for F4 {
+    type Target = [f32; LANES];
+    #[inline(always)]
+    fn deref(&self) -> &[f32; LANES] {
+        as_lanes::f(&self.0)
+    }
+}
+
+impl core::ops::DerefMut for F4 {
+    #[inline(always)]
+    fn deref_mut(&mut self) -> &mut [f32; LANES] {
+        as_lanes::f_mut(&mut self.0)
+    }
+}
+
+impl core::ops::Deref for M4 {
+    type Target = [u32; LANES];
+    #[inline(always)]
+    fn deref(&self) -> &[u32; LANES] {
+        as_lanes::m(&self.0)
+    }
+}
+
+impl core::ops::DerefMut for M4 {
+    #[inline(always)]
+    fn deref_mut(&mut self) -> &mut [u32; LANES] {
+        as_lanes::m_mut(&mut self.0)
+    }
+}
+
+impl PartialEq for F4 {
+    fn eq(&self, o: &F4) -> bool {
+        **self == **o
+    }
+}
+
+impl PartialEq for M4 {
+    fn eq(&self, o: &M4) -> bool {
+        **self == **o
+    }
+}
+
+impl Eq for M4 {}
+
+impl Default for F4 {
+    fn default() -> F4 {
+        F4::ZERO
+    }
+}
+
+impl Default for M4 {
+    fn default() -> M4 {
+        M4::new([0; LANES])
+    }
+}
+
+impl core::fmt::Debug for F4 {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "F4({:?})", **self)
+    }
+}
+
+impl core::fmt::Debug for M4 {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "M4({:?})", **self)
+    }
+}
+
+/// The lanes of a register as an array, in place.
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod as_lanes {
+    use super::{Raw, LANES};
+
+    #[inline(always)]
+    pub fn f(r: &Raw) -> &[f32; LANES] {
+        // SAFETY: `__m128` is 16 bytes of four `f32` lanes in order (lane 0 first), aligned
+        // to 16; every bit pattern is a valid `f32` and `u32`, and the borrow is the
+        // register's.
+        unsafe { &*(r as *const Raw as *const [f32; LANES]) }
+    }
+
+    #[inline(always)]
+    pub fn f_mut(r: &mut Raw) -> &mut [f32; LANES] {
+        // SAFETY: as `f`.
+        unsafe { &mut *(r as *mut Raw as *mut [f32; LANES]) }
+    }
+
+    #[inline(always)]
+    pub fn m(r: &Raw) -> &[u32; LANES] {
+        // SAFETY: as `f`.
+        unsafe { &*(r as *const Raw as *const [u32; LANES]) }
+    }
+
+    #[inline(always)]
+    pub fn m_mut(r: &mut Raw) -> &mut [u32; LANES] {
+        // SAFETY: as `f`.
+        unsafe { &mut *(r as *mut Raw as *mut [u32; LANES]) }
+    }
+
+    /// An array's lanes as a register (a constant expression).
+    pub const fn from_f(a: [f32; LANES]) -> Raw {
+        // SAFETY: same size, every bit pattern valid (see `f`).
+        unsafe { core::mem::transmute::<[f32; LANES], Raw>(a) }
+    }
+
+    pub const fn from_m(a: [u32; LANES]) -> Raw {
+        // SAFETY: as `from_f`.
+        unsafe { core::mem::transmute::<[u32; LANES], Raw>(a) }
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+mod as_lanes {
+    use super::LANES;
+    #[inline(always)]
+    pub fn f(r: &[f32; LANES]) -> &[f32; LANES] {
+        r
+    }
+    #[inline(always)]
+    pub fn f_mut(r: &mut [f32; LANES]) -> &mut [f32; LANES] {
+        r
+    }
+    #[inline(always)]
+    pub fn m(r: &[u32; LANES]) -> &[u32; LANES] {
+        r
+    }
+    #[inline(always)]
+    pub fn m_mut(r: &mut [u32; LANES]) -> &mut [u32; LANES] {
+        r
+    }
+    pub const fn from_f(a: [f32; LANES]) -> [f32; LANES] {
+        a
+    }
+    pub const fn from_m(a: [u32; LANES]) -> [u32; LANES] {
+        a
+    }
+}
+
+impl F4 {
+    /// Lanes from an array.
+    #[inline(always)]
+    pub const fn new(a: [f32; LANES]) -> F4 {
+        F4(as_lanes::from_f(a))
+    }
+}
+
+impl M4 {
+    /// Masks from an array.
+    #[inline(always)]
+    pub const fn new(a: [u32; LANES]) -> M4 {
+        M4(as_lanes::from_m(a))
+    }
+}
 
 /// The SSE forms of the lane operations: x86-64's baseline SSE/SSE2 intrinsics, wrapped as
 /// safe functions (the crate's third `unsafe` site).
@@ -47,7 +221,6 @@ mod sse {
     }
 
     baseline! {
-        _mm_setr_ps(a: f32, b: f32, c: f32, d: f32) -> __m128;
         _mm_set1_ps(a: f32) -> __m128;
         _mm_setr_epi32(a: i32, b: i32, c: i32, d: i32) -> __m128i;
         _mm_set1_epi32(a: i32) -> __m128i;
@@ -56,8 +229,6 @@ mod sse {
         _mm_or_si128(a: __m128i, b: __m128i) -> __m128i;
         _mm_setzero_si128() -> __m128i;
         _mm_castps_si128(a: __m128) -> __m128i;
-        _mm_cvtss_f32(a: __m128) -> f32;
-        _mm_cvtsi128_si32(a: __m128i) -> i32;
         _mm_add_ps(a: __m128, b: __m128) -> __m128;
         _mm_sub_ps(a: __m128, b: __m128) -> __m128;
         _mm_mul_ps(a: __m128, b: __m128) -> __m128;
@@ -79,53 +250,24 @@ mod sse {
         _mm_movehl_ps(a: __m128, b: __m128) -> __m128;
     }
 
-    /// Lane `L` of `v` moved to lane 0.
-    #[inline(always)]
-    fn lane<const L: i32>(v: __m128) -> __m128 {
-        // SAFETY: as `baseline!`.
-        unsafe { core::arch::x86_64::_mm_shuffle_ps::<L>(v, v) }
-    }
-
-    #[inline(always)]
-    fn lane_i<const L: i32>(v: __m128i) -> __m128i {
-        // SAFETY: as `baseline!`.
-        unsafe { core::arch::x86_64::_mm_shuffle_epi32::<L>(v) }
-    }
-
     #[inline(always)]
     pub fn f(x: F4) -> __m128 {
-        _mm_setr_ps(x.0[0], x.0[1], x.0[2], x.0[3])
+        x.0
     }
 
     #[inline(always)]
     pub fn m(x: M4) -> __m128 {
-        _mm_castsi128_ps(_mm_setr_epi32(
-            x.0[0] as i32,
-            x.0[1] as i32,
-            x.0[2] as i32,
-            x.0[3] as i32,
-        ))
+        x.0
     }
 
     #[inline(always)]
     pub fn to_f(v: __m128) -> F4 {
-        F4([
-            _mm_cvtss_f32(v),
-            _mm_cvtss_f32(lane::<0b01_01_01_01>(v)),
-            _mm_cvtss_f32(lane::<0b10_10_10_10>(v)),
-            _mm_cvtss_f32(lane::<0b11_11_11_11>(v)),
-        ])
+        F4(v)
     }
 
     #[inline(always)]
     pub fn to_m(v: __m128) -> M4 {
-        let i = _mm_castps_si128(v);
-        M4([
-            _mm_cvtsi128_si32(i) as u32,
-            _mm_cvtsi128_si32(lane_i::<0b01_01_01_01>(i)) as u32,
-            _mm_cvtsi128_si32(lane_i::<0b10_10_10_10>(i)) as u32,
-            _mm_cvtsi128_si32(lane_i::<0b11_11_11_11>(i)) as u32,
-        ])
+        M4(v)
     }
 }
 
@@ -159,11 +301,11 @@ macro_rules! lanes {
 }
 
 impl F4 {
-    pub const ZERO: F4 = F4([0.0; LANES]);
+    pub const ZERO: F4 = F4::new([0.0; LANES]);
 
     #[inline(always)]
     pub fn splat(x: f32) -> F4 {
-        F4([x; LANES])
+        simd!(sse::to_f(_mm_set1_ps(x)), F4::new([x; LANES]))
     }
 
     /// Lane-wise maximum (`a > b ? a : b`, like SSE `maxps` with the operands swapped).
@@ -171,7 +313,7 @@ impl F4 {
     pub fn max(self, o: F4) -> F4 {
         simd!(
             sse::to_f(_mm_max_ps(sse::f(self), sse::f(o))),
-            F4(lanes!(|i| if self.0[i] > o.0[i] { self.0[i] } else { o.0[i] }))
+            F4::new(lanes!(|i| if self[i] > o[i] { self[i] } else { o[i] }))
         )
     }
 
@@ -180,7 +322,7 @@ impl F4 {
     pub fn min(self, o: F4) -> F4 {
         simd!(
             sse::to_f(_mm_min_ps(sse::f(self), sse::f(o))),
-            F4(lanes!(|i| if self.0[i] < o.0[i] { self.0[i] } else { o.0[i] }))
+            F4::new(lanes!(|i| if self[i] < o[i] { self[i] } else { o[i] }))
         )
     }
 
@@ -192,14 +334,17 @@ impl F4 {
     /// Lane-wise square root (IEEE, as `f32::sqrt`).
     #[inline(always)]
     pub fn sqrt(self) -> F4 {
-        simd!(sse::to_f(_mm_sqrt_ps(sse::f(self))), F4(lanes!(|i| self.0[i].sqrt())))
+        simd!(
+            sse::to_f(_mm_sqrt_ps(sse::f(self))),
+            F4::new(lanes!(|i| self[i].sqrt()))
+        )
     }
 
     #[inline(always)]
     pub fn abs(self) -> F4 {
         simd!(
             sse::to_f(_mm_and_ps(sse::f(self), _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff)))),
-            F4(lanes!(|i| f32::from_bits(self.0[i].to_bits() & 0x7fff_ffff)))
+            F4::new(lanes!(|i| f32::from_bits(self[i].to_bits() & 0x7fff_ffff)))
         )
     }
 
@@ -207,7 +352,7 @@ impl F4 {
     pub fn gt(self, o: F4) -> M4 {
         simd!(
             sse::to_m(_mm_cmpgt_ps(sse::f(self), sse::f(o))),
-            M4(lanes!(|i| mask(self.0[i] > o.0[i])))
+            M4::new(lanes!(|i| mask(self[i] > o[i])))
         )
     }
 
@@ -215,7 +360,7 @@ impl F4 {
     pub fn ge(self, o: F4) -> M4 {
         simd!(
             sse::to_m(_mm_cmpge_ps(sse::f(self), sse::f(o))),
-            M4(lanes!(|i| mask(self.0[i] >= o.0[i])))
+            M4::new(lanes!(|i| mask(self[i] >= o[i])))
         )
     }
 
@@ -223,7 +368,7 @@ impl F4 {
     pub fn lt(self, o: F4) -> M4 {
         simd!(
             sse::to_m(_mm_cmplt_ps(sse::f(self), sse::f(o))),
-            M4(lanes!(|i| mask(self.0[i] < o.0[i])))
+            M4::new(lanes!(|i| mask(self[i] < o[i])))
         )
     }
 }
@@ -246,7 +391,7 @@ pub(crate) fn transpose(rows: [F4; LANES]) -> [F4; LANES] {
             ]
             .map(sse::to_f)
         },
-        core::array::from_fn(|i| F4(core::array::from_fn(|j| rows[j].0[i])))
+        core::array::from_fn(|i| F4::new(core::array::from_fn(|j| rows[j][i])))
     )
 }
 
@@ -262,13 +407,13 @@ fn mask(b: bool) -> u32 {
 impl M4 {
     #[inline(always)]
     pub fn lane(self, i: usize) -> bool {
-        self.0[i] != 0
+        self[i] != 0
     }
 
     /// A mask from four booleans.
     #[inline(always)]
     pub fn from_bools(b: [bool; LANES]) -> M4 {
-        M4(b.map(mask))
+        M4::new(b.map(mask))
     }
 
     /// The lanes where `a` or `b` is zero.
@@ -283,7 +428,7 @@ impl M4 {
                     _mm_cmpeq_epi32(v(b), z),
                 )))
             },
-            M4(lanes!(|i| mask(a[i] == 0 || b[i] == 0)))
+            M4::new(lanes!(|i| mask(a[i] == 0 || b[i] == 0)))
         )
     }
 
@@ -292,7 +437,7 @@ impl M4 {
     pub fn any(self) -> bool {
         simd!(
             _mm_movemask_ps(sse::m(self)) != 0,
-            (self.0[0] | self.0[1] | self.0[2] | self.0[3]) != 0
+            (self[0] | self[1] | self[2] | self[3]) != 0
         )
     }
 
@@ -301,7 +446,7 @@ impl M4 {
     pub fn all(self) -> bool {
         simd!(
             _mm_movemask_ps(sse::m(self)) == 0b1111,
-            (self.0[0] & self.0[1] & self.0[2] & self.0[3]) == u32::MAX
+            (self[0] & self[1] & self[2] & self[3]) == u32::MAX
         )
     }
 
@@ -313,8 +458,8 @@ impl M4 {
                 let m = sse::m(self);
                 sse::to_f(_mm_or_ps(_mm_and_ps(m, sse::f(a)), _mm_andnot_ps(m, sse::f(b))))
             },
-            F4(lanes!(|i| f32::from_bits(
-                (a.0[i].to_bits() & self.0[i]) | (b.0[i].to_bits() & !self.0[i])
+            F4::new(lanes!(|i| f32::from_bits(
+                (a[i].to_bits() & self[i]) | (b[i].to_bits() & !self[i])
             )))
         )
     }
@@ -324,7 +469,7 @@ impl M4 {
     pub fn to_unit(self) -> F4 {
         simd!(
             sse::to_f(_mm_and_ps(sse::m(self), _mm_set1_ps(1.0))),
-            F4(lanes!(|i| f32::from_bits(1.0f32.to_bits() & self.0[i])))
+            F4::new(lanes!(|i| f32::from_bits(1.0f32.to_bits() & self[i])))
         )
     }
 }
@@ -335,7 +480,7 @@ macro_rules! f4_binop {
             type Output = F4;
             #[inline(always)]
             fn $f(self, o: F4) -> F4 {
-                simd!(sse::to_f($sse(sse::f(self), sse::f(o))), F4(lanes!(|i| self.0[i] $op o.0[i])))
+                simd!(sse::to_f($sse(sse::f(self), sse::f(o))), F4::new(lanes!(|i| self[i] $op o[i])))
             }
         }
     };
@@ -359,7 +504,7 @@ impl Neg for F4 {
     fn neg(self) -> F4 {
         simd!(
             sse::to_f(_mm_xor_ps(sse::f(self), _mm_set1_ps(-0.0))),
-            F4(lanes!(|i| -self.0[i]))
+            F4::new(lanes!(|i| -self[i]))
         )
     }
 }
@@ -384,7 +529,7 @@ impl BitAnd for M4 {
     fn bitand(self, o: M4) -> M4 {
         simd!(
             sse::to_m(_mm_and_ps(sse::m(self), sse::m(o))),
-            M4(lanes!(|i| self.0[i] & o.0[i]))
+            M4::new(lanes!(|i| self[i] & o[i]))
         )
     }
 }
@@ -395,7 +540,7 @@ impl BitOr for M4 {
     fn bitor(self, o: M4) -> M4 {
         simd!(
             sse::to_m(_mm_or_ps(sse::m(self), sse::m(o))),
-            M4(lanes!(|i| self.0[i] | o.0[i]))
+            M4::new(lanes!(|i| self[i] | o[i]))
         )
     }
 }
@@ -406,7 +551,7 @@ impl Not for M4 {
     fn not(self) -> M4 {
         simd!(
             sse::to_m(_mm_xor_ps(sse::m(self), _mm_castsi128_ps(_mm_set1_epi32(-1)))),
-            M4(lanes!(|i| !self.0[i]))
+            M4::new(lanes!(|i| !self[i]))
         )
     }
 }
@@ -473,27 +618,31 @@ mod tests {
 
     #[test]
     fn lanes_match_scalar_arithmetic() {
-        let a = F4([1.5, -2.0, 0.0, 3.25]);
-        let b = F4([0.5, 4.0, -0.0, -1.0]);
-        assert_eq!((a + b).0, [2.0, 2.0, 0.0, 2.25]);
-        assert_eq!((a * b).0, [0.75, -8.0, -0.0, -3.25]);
-        assert_eq!(a.max(b).0, [1.5, 4.0, -0.0, 3.25]);
-        assert_eq!(a.min(b).0, [0.5, -2.0, -0.0, -1.0]);
-        assert_eq!(a.abs().0, [1.5, 2.0, 0.0, 3.25]);
+        let a = F4::new([1.5, -2.0, 0.0, 3.25]);
+        let b = F4::new([0.5, 4.0, -0.0, -1.0]);
+        assert_eq!(*(a + b), [2.0, 2.0, 0.0, 2.25]);
+        assert_eq!(*(a * b), [0.75, -8.0, -0.0, -3.25]);
+        assert_eq!(*a.max(b), [1.5, 4.0, -0.0, 3.25]);
+        assert_eq!(*a.min(b), [0.5, -2.0, -0.0, -1.0]);
+        assert_eq!(*a.abs(), [1.5, 2.0, 0.0, 3.25]);
         let m = a.gt(b);
-        assert_eq!(m.select(a, b).0, [1.5, 4.0, -0.0, 3.25]);
-        assert_eq!(m.to_unit().0, [1.0, 0.0, 0.0, 1.0]);
-        assert_eq!((!m & a.ge(b)).0, [0, 0, u32::MAX, 0]);
+        assert_eq!(*m.select(a, b), [1.5, 4.0, -0.0, 3.25]);
+        assert_eq!(*m.to_unit(), [1.0, 0.0, 0.0, 1.0]);
+        assert_eq!(*(!m & a.ge(b)), [0, 0, u32::MAX, 0]);
         assert!(!m.all() && (m | !m).all());
+        // A lane written through the array view is read back by the register operations.
+        let mut c = a;
+        c[2] = 5.0;
+        assert_eq!(*(c + b), [2.0, 2.0, 5.0, 2.25]);
         let rows = [a, b, a + b, a * b];
         let cols = transpose(rows);
         for (i, col) in cols.iter().enumerate() {
-            assert_eq!(col.0, [a.0[i], b.0[i], (a + b).0[i], (a * b).0[i]]);
+            assert_eq!(**col, [a[i], b[i], (a + b)[i], (a * b)[i]]);
         }
         assert_eq!(transpose(cols), rows);
         // Body indices: 0 is the static body; u32::MAX must not read as a negative zero.
         let (ia, ib) = ([0, 7, 3, u32::MAX], [5, 0, 9, 1]);
-        assert_eq!(M4::either_zero(ia, ib).0, [u32::MAX, u32::MAX, 0, 0]);
-        assert_eq!(M4::either_zero([0; LANES], [0; LANES]).0, [u32::MAX; LANES]);
+        assert_eq!(*M4::either_zero(ia, ib), [u32::MAX, u32::MAX, 0, 0]);
+        assert_eq!(*M4::either_zero([0; LANES], [0; LANES]), [u32::MAX; LANES]);
     }
 }
