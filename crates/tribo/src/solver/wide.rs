@@ -44,47 +44,40 @@ pub(crate) struct M4(RawM);
 
 const _: () = assert!(core::mem::size_of::<F4>() == 16 && core::mem::size_of::<M4>() == 16);
 
-impl core::ops::Deref for F4 {
-    type Target = [f32; LANES];
-    #[inline(always)]
-    fn deref(&self) -> &[f32; LANES] {
-        as_lanes::f(&self.0)
-    }
-}
+/// The lanes of `$t` as an array of `$e` through `Deref` (`as_lanes::$view`), and the
+/// comparison and debug print that read them.
+macro_rules! lane_array {
+    ($t:ident, $e:ty, $view:ident, $view_mut:ident) => {
+        impl core::ops::Deref for $t {
+            type Target = [$e; LANES];
+            #[inline(always)]
+            fn deref(&self) -> &[$e; LANES] {
+                as_lanes::$view(&self.0)
+            }
+        }
 
-impl core::ops::DerefMut for F4 {
-    #[inline(always)]
-    fn deref_mut(&mut self) -> &mut [f32; LANES] {
-        as_lanes::f_mut(&mut self.0)
-    }
-}
+        impl core::ops::DerefMut for $t {
+            #[inline(always)]
+            fn deref_mut(&mut self) -> &mut [$e; LANES] {
+                as_lanes::$view_mut(&mut self.0)
+            }
+        }
 
-impl core::ops::Deref for M4 {
-    type Target = [u32; LANES];
-    #[inline(always)]
-    fn deref(&self) -> &[u32; LANES] {
-        as_lanes::m(&self.0)
-    }
-}
+        impl PartialEq for $t {
+            fn eq(&self, o: &$t) -> bool {
+                **self == **o
+            }
+        }
 
-impl core::ops::DerefMut for M4 {
-    #[inline(always)]
-    fn deref_mut(&mut self) -> &mut [u32; LANES] {
-        as_lanes::m_mut(&mut self.0)
-    }
+        impl core::fmt::Debug for $t {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                write!(f, concat!(stringify!($t), "({:?})"), **self)
+            }
+        }
+    };
 }
-
-impl PartialEq for F4 {
-    fn eq(&self, o: &F4) -> bool {
-        **self == **o
-    }
-}
-
-impl PartialEq for M4 {
-    fn eq(&self, o: &M4) -> bool {
-        **self == **o
-    }
-}
+lane_array!(F4, f32, f, f_mut);
+lane_array!(M4, u32, m, m_mut);
 
 impl Eq for M4 {}
 
@@ -97,18 +90,6 @@ impl Default for F4 {
 impl Default for M4 {
     fn default() -> M4 {
         M4::new([0; LANES])
-    }
-}
-
-impl core::fmt::Debug for F4 {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(f, "F4({:?})", **self)
-    }
-}
-
-impl core::fmt::Debug for M4 {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(f, "M4({:?})", **self)
     }
 }
 

@@ -960,17 +960,12 @@ impl World {
             rested |= rests(b, tts);
             if let Some(sb) = self.solver_bodies.get_mut(bi as usize) {
                 sb.rest = b.sleep_time;
-            }
-            if let (true, Some(state), Some(sim), Some(sb)) = (
-                fresh,
-                self.states.get_mut(k),
-                self.sims.get_mut(k),
-                self.solver_bodies.get_mut(bi as usize),
-            ) {
-                *state = body_state(b);
-                *sim = body_sim(b, bi, g);
-                move_entry(sb, b);
-                loaded += usize::from(loads(sim));
+                if let (true, Some(state), Some(sim)) = (fresh, self.states.get_mut(k), self.sims.get_mut(k)) {
+                    *state = body_state(b);
+                    *sim = body_sim(b, bi, g);
+                    move_entry(sb, b);
+                    loaded += usize::from(loads(sim));
+                }
             }
             let Some(bullet) = self.finite_or_reported(bi) else {
                 continue;
