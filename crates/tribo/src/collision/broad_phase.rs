@@ -70,6 +70,8 @@ pub(crate) struct BroadPhase {
     pub pairs: HashMap<u64, u32, BuildPairHasher>,
     /// Query copies of the trees ([`FlatTree`]), made when a step queries many proxies.
     pub flat: [FlatTree; 2],
+    /// Scratch of the pair update: the keys of the overlapping pairs with a moved proxy.
+    pub scratch_keys: Vec<u64>,
     /// Scratch of the pair update: per shape slot, whether its proxy moved.
     pub moved_mark: Vec<bool>,
     /// Pair updates that walked the moving tree against itself (diagnostics and tests).

@@ -199,17 +199,21 @@ impl World {
                 *m = true;
             }
         }
-        let mut fresh: Vec<u64> = Vec::new();
-        let pairs = &self.broad_phase.pairs;
+        let mut keys = core::mem::take(&mut self.broad_phase.scratch_keys);
+        keys.clear();
         self.broad_phase.flat[MOVING_TREE as usize].self_pairs(|a, b| {
             let moved = |s: u64| mark.get(s as usize).copied().unwrap_or(false);
             if moved(a) || moved(b) {
-                let key = pair_key(a as u32, b as u32);
-                if !pairs.contains_key(&key) {
-                    fresh.push(key);
-                }
+                keys.push(pair_key(a as u32, b as u32));
             }
         });
+        // The keys are looked up after the walk, in a loop of lookups whose cache misses
+        // overlap: inside the walk, among its branches, each waited alone (5 % of smash's
+        // step at one instruction; pairs stage 1.54 → 1.44 ms in smash, 2.26 → 2.14 in
+        // rain, 0.504 → 0.490 in tumbler).
+        let pairs = &self.broad_phase.pairs;
+        let fresh: Vec<u64> = keys.iter().copied().filter(|key| !pairs.contains_key(key)).collect();
+        self.broad_phase.scratch_keys = keys;
         for key in fresh {
             let (sa, sb) = ((key >> 32) as u32, key as u32);
             let (Some(s), Some(o)) = (self.shapes.at(sa), self.shapes.at(sb)) else {
