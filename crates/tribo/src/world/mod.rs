@@ -1147,23 +1147,27 @@ impl World {
             self.order_checked = Some(layout);
             return;
         }
-        let mut new_of_old = vec![u32::MAX; self.contacts.len()];
-        let mut contacts = Vec::with_capacity(self.contacts.len() - self.contact_free.len());
-        let mut place = |slot: &mut Option<Contact>, old: u32, contacts: &mut Vec<Option<Contact>>| {
-            if let Some(c) = slot.take() {
-                new_of_old[old as usize] = contacts.len() as u32;
-                contacts.push(Some(c));
+        // Each live contact's new index: the solver's order first, then the others in
+        // index order (each placed once).
+        let n = self.contacts.len();
+        let mut new_of_old = vec![u32::MAX; n];
+        let mut live = 0u32;
+        let contacts = &self.contacts;
+        let mut place = |old: usize| {
+            if let (Some(Some(_)), Some(new)) = (contacts.get(old), new_of_old.get_mut(old)) {
+                if *new == u32::MAX {
+                    *new = live;
+                    live += 1;
+                }
             }
         };
         for &old in &order {
-            if let Some(slot) = self.contacts.get_mut(old as usize) {
-                place(slot, old, &mut contacts);
-            }
+            place(old as usize);
         }
-        for (old, slot) in self.contacts.iter_mut().enumerate() {
-            place(slot, old as u32, &mut contacts);
+        for old in 0..n {
+            place(old);
         }
-        self.contacts = contacts;
+        permute_live(&mut self.contacts, &new_of_old, live);
         self.contact_free.clear();
         self.reordered_at = Some(self.step_count);
         let renumber = |ci: &mut u32| *ci = new_of_old.get(*ci as usize).copied().unwrap_or(u32::MAX);
@@ -1205,6 +1209,30 @@ impl World {
             }
         }
     }
+}
+
+/// Moves each live item of `items` to its place in `new_of_old` (the live items' places
+/// are 0 .. `live`, each given once; `u32::MAX` for a free slot) and cuts off the free
+/// slots. In place, cycle by cycle: each swap puts one item where it goes, the free slots
+/// going after the live items. (A new array for the contacts cost a page fault per 4 KiB
+/// at every renumbering: smash's first, of 40 000 contacts, took 7.6 ms, most of it
+/// faulting in 13 MB; in place, its five renumberings took 12.7 ms instead of 20.7, and
+/// tumbler's 22 took 5.8 ms instead of 17.5.)
+fn permute_live<T>(items: &mut Vec<Option<T>>, new_of_old: &[u32], live: u32) {
+    let n = items.len();
+    let mut dest = new_of_old.to_vec();
+    dest.resize(n, u32::MAX);
+    for (free, d) in (live..).zip(dest.iter_mut().filter(|d| **d == u32::MAX)) {
+        *d = free;
+    }
+    for i in 0..n {
+        // A place out of range (not a permutation: a caller's bug) ends the cycle.
+        while let Some(&j) = dest.get(i).filter(|&&j| j as usize != i && (j as usize) < n) {
+            items.swap(i, j as usize);
+            dest.swap(i, j as usize);
+        }
+    }
+    items.truncate(live as usize);
 }
 
 /// The box a shape needs in the broad phase: its tight box grown by the speculative
@@ -1373,6 +1401,33 @@ mod tests {
     /// same pairs touch; only their indices differ. And the pyramid stands: its top box
     /// sinks less than 1 cm in 40 steps (the soft contacts' preload carries the load
     /// without deflection; a failing solve would let it sag centimetres).
+    /// The in-place renumbering gives what building a new array in the new order gives:
+    /// each live item at its new index, the free slots gone, for scattered free slots and
+    /// a shuffled order (a fixed-seed linear congruential shuffle).
+    #[test]
+    fn permuting_in_place_matches_a_new_array() {
+        let n = 1000usize;
+        let items: Vec<Option<u32>> = (0..n as u32).map(|i| (i % 7 != 3).then_some(i)).collect();
+        let mut order: Vec<usize> = (0..n).collect();
+        let mut seed = 12345u64;
+        for i in (1..n).rev() {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            order.swap(i, (seed >> 33) as usize % (i + 1));
+        }
+        let mut new_of_old = vec![u32::MAX; n];
+        let mut expected = Vec::new();
+        for &old in &order {
+            if let Some(x) = items[old] {
+                new_of_old[old] = expected.len() as u32;
+                expected.push(Some(x));
+            }
+        }
+        let mut got = items.clone();
+        permute_live(&mut got, &new_of_old, expected.len() as u32);
+        assert_eq!(got, expected);
+        assert!(expected.len() < n && got.iter().all(Option::is_some));
+    }
+
     #[test]
     fn renumbering_the_contacts_changes_no_result() {
         let rows = 70; // 2 485 boxes, over 7 000 contacts: above REORDER_MIN_CONTACTS
