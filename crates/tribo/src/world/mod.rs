@@ -1393,14 +1393,6 @@ mod tests {
         w
     }
 
-    /// Renumbering the contacts in the solver's layout order (`World::reorder_contacts`)
-    /// changes no result: a pile whose contacts stay the same keeps its colours (greedy
-    /// colouring of an unchanged set in any order that keeps each colour's members in
-    /// turn gives them back), so the solver does the same arithmetic in the same order and
-    /// every pose and velocity is bit for bit that of a world that never renumbers. The
-    /// same pairs touch; only their indices differ. And the pyramid stands: its top box
-    /// sinks less than 1 cm in 40 steps (the soft contacts' preload carries the load
-    /// without deflection; a failing solve would let it sag centimetres).
     /// The in-place renumbering gives what building a new array in the new order gives:
     /// each live item at its new index, the free slots gone, for scattered free slots and
     /// a shuffled order (a fixed-seed linear congruential shuffle).
@@ -1428,6 +1420,14 @@ mod tests {
         assert!(expected.len() < n && got.iter().all(Option::is_some));
     }
 
+    /// Renumbering the contacts in the solver's layout order (`World::reorder_contacts`)
+    /// changes no result: a pile whose contacts stay the same keeps its colours (greedy
+    /// colouring of an unchanged set in any order that keeps each colour's members in
+    /// turn gives them back), so the solver does the same arithmetic in the same order and
+    /// every pose and velocity is bit for bit that of a world that never renumbers. The
+    /// same pairs touch; only their indices differ. And the pyramid stands: its top box
+    /// sinks less than 1 cm in 40 steps (the soft contacts' preload carries the load
+    /// without deflection; a failing solve would let it sag centimetres).
     #[test]
     fn renumbering_the_contacts_changes_no_result() {
         let rows = 70; // 2 485 boxes, over 7 000 contacts: above REORDER_MIN_CONTACTS
