@@ -248,8 +248,8 @@ impl World {
     /// slot order (a joint between two sleeping or non-dynamic bodies does nothing).
     pub(crate) fn build_joints(&mut self, ctx: &crate::solver::StepContext) {
         use crate::solver::joint_solver::{JointBody, JointConstraint};
-        let mut constraints = core::mem::take(&mut self.joint_solver.constraints);
-        constraints.clear();
+        let mut solver = core::mem::take(&mut self.joint_solver);
+        solver.clear();
         for (ji, j) in self.joints.iter() {
             let side = |bi: u32| -> Option<JointBody> {
                 let b = self.bodies.at(bi)?;
@@ -270,9 +270,10 @@ impl World {
             if !a.dynamic && !b.dynamic {
                 continue;
             }
-            constraints.push(JointConstraint::new(ji, j, &a, &b, ctx));
+            solver.push(JointConstraint::new(ji, j, &a, &b, ctx));
         }
-        self.joint_solver.constraints = constraints;
+        solver.order_joints(self.states.len());
+        self.joint_solver = solver;
     }
 
     /// Writes the joints' accumulated impulses back into their records.
