@@ -192,6 +192,14 @@ impl JointConstraint {
         b.w += self.inv_i_b * (b.r.cross(p) + l);
     }
 
+    /// Applies an angular impulse `l` [N·m·s] (on B, −l on A): [`JointConstraint::apply`]
+    /// without the point's terms.
+    #[inline]
+    fn apply_angular(&self, a: &mut Body, b: &mut Body, l: f32) {
+        a.w -= self.inv_i_a * l;
+        b.w += self.inv_i_b * l;
+    }
+
     /// Re-applies the accumulated impulses at the start of a substep.
     pub fn warm_start<S: StateCell>(&self, states: &[S]) {
         let (mut a, mut b) = self.load(states);
@@ -211,33 +219,37 @@ impl JointConstraint {
     pub fn solve<S: StateCell>(&mut self, states: &[S], ctx: &StepContext, use_bias: bool) {
         let (mut a, mut b) = self.load(states);
         let k = self.axial_mass;
-        if self.enable_spring && use_bias && k > 0.0 {
-            let c = self.angle(&a, &b);
+        // The angle reads only the rotations, which the rows do not change: one atan2 for
+        // the spring and the limits.
+        let spring = self.enable_spring && use_bias && k > 0.0;
+        let limit = self.enable_limit && k > 0.0;
+        let angle = if spring || limit { self.angle(&a, &b) } else { 0.0 };
+        if spring {
+            let c = angle;
             let s = self.spring;
             let imp = -s.mass_scale * k * (b.w - a.w + s.bias_rate * c) - s.impulse_scale * self.impulses.spring;
             self.impulses.spring += imp;
-            self.apply(&mut a, &mut b, Vec2::ZERO, imp);
+            self.apply_angular(&mut a, &mut b, imp);
         }
         if self.enable_motor && k > 0.0 {
             let imp = -k * (b.w - a.w - self.motor_speed);
             let old = self.impulses.motor;
             self.impulses.motor = (old + imp).clamp(-self.max_motor_impulse, self.max_motor_impulse);
-            self.apply(&mut a, &mut b, Vec2::ZERO, self.impulses.motor - old);
+            self.apply_angular(&mut a, &mut b, self.impulses.motor - old);
         }
-        if self.enable_limit && k > 0.0 {
-            let angle = self.angle(&a, &b);
+        if limit {
             // Lower: C = θ − lower ≥ 0, pushing ω_B − ω_A up.
             let (bias, ms, is) = self.limit_row(angle - self.lower, ctx, use_bias);
             let old = self.impulses.lower;
             let imp = -k * ms * (b.w - a.w + bias) - is * old;
             self.impulses.lower = (old + imp).max(0.0);
-            self.apply(&mut a, &mut b, Vec2::ZERO, self.impulses.lower - old);
+            self.apply_angular(&mut a, &mut b, self.impulses.lower - old);
             // Upper: C = upper − θ ≥ 0, pushing ω_A − ω_B up.
             let (bias, ms, is) = self.limit_row(self.upper - angle, ctx, use_bias);
             let old = self.impulses.upper;
             let imp = -k * ms * (a.w - b.w + bias) - is * old;
             self.impulses.upper = (old + imp).max(0.0);
-            self.apply(&mut a, &mut b, Vec2::ZERO, -(self.impulses.upper - old));
+            self.apply_angular(&mut a, &mut b, -(self.impulses.upper - old));
         }
         // The point.
         let c = self.delta_center + (b.dp - a.dp) + (b.r - a.r);
