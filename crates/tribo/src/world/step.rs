@@ -285,7 +285,12 @@ impl World {
             .pairs
             .get(&key)
             .and_then(|&ci| self.contacts.get(ci as usize));
-        matches!(contact, Some(Some(c)) if c.manifold.count > 0)
+        // `touching` (the record's first line, which the store just wrote for a solved
+        // contact) rather than the manifold's count (its third line, last read by the
+        // narrow phase): the same fact (`Contact::update`, `clear_manifold`), and in the
+        // spinner's finalize, which asks it for every fast body's static neighbours, the
+        // count's line was a cache miss.
+        matches!(contact, Some(Some(c)) if c.touching)
     }
 
     fn create_contact(&mut self, sa: u32, sb: u32) {
