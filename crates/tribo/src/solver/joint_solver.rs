@@ -128,7 +128,7 @@ impl JointConstraint {
             delta_center: b.center - a.center,
             // Only the limit and the spring read the angle (an atan2 per joint and step,
             // the fast one as in the passes: `atan2f` here was 2 % of rain's step; the
-            // API's `World::joint_angle` keeps the exact one).
+            // API's `World::revolute_angle` keeps the exact one).
             angle0: if d.enable_limit || d.enable_spring {
                 unwind_angle(a.q.inv_mul(b.q).angle_fast() - d.reference_angle)
             } else {
