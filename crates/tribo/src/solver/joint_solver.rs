@@ -334,7 +334,7 @@ pub(crate) struct JointSolver {
     /// The same for this step's constraints (filled by [`JointSolver::push`]).
     writes: Vec<[u32; 2]>,
     /// Scratch of the colouring: per solver state, the colours its joints took in the
-    /// current window.
+    /// current window (all zero between windows).
     used: Vec<u32>,
 }
 
@@ -373,8 +373,10 @@ impl JointSolver {
         }
         core::mem::swap(&mut self.order_bodies, &mut self.writes);
         self.order.clear();
-        self.used.clear();
-        self.used.resize(states, 0);
+        // All zero already (each window clears what it set): only grown.
+        if self.used.len() < states {
+            self.used.resize(states, 0);
+        }
         let used = &mut self.used;
         for (w, window) in self.order_bodies.chunks(ORDER_WINDOW).enumerate() {
             let first = w * ORDER_WINDOW;
