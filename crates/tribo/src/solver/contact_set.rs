@@ -1031,8 +1031,7 @@ impl ContactSolver {
                     }
                 }
             }
-            let mut out = [StoredContact::default(); LANES];
-            contact_wide::store_group(h, w, cold, states, ctx, &mut out);
+            let out = contact_wide::store_group(h, w, cold, states, ctx);
             let (Some(lanes), Some(&colour)) = (self.lane_candidates.get(g), self.group_colour.get(g)) else {
                 continue;
             };

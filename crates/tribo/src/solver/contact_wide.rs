@@ -953,8 +953,7 @@ pub(crate) fn store_group<S: StateRead>(
     cold: &WideCold,
     states: &[S],
     ctx: &StepContext,
-    out: &mut [StoredContact; LANES],
-) {
+) -> [StoredContact; LANES] {
     let a = gather(states, &h.index_a);
     let b = gather(states, &h.index_b);
     let d = b.dp - a.dp;
@@ -989,11 +988,10 @@ pub(crate) fn store_group<S: StateRead>(
     let stick_speed = F4::splat(ctx.stick_speed);
     let restitution = F4::new(cold.restitution);
     let threshold = -F4::new(cold.restitution_threshold);
-    for (o, (&count, &rolling)) in out.iter_mut().zip(cold.count.iter().zip(h.rolling_impulse.iter())) {
-        o.count = count.min(2);
-        o.rolling_impulse = rolling;
-    }
-    for i in 0..2 {
+    // Each point's states, four lanes; the output is built from them at the end (filling
+    // a default-made array field by field stalled on store forwarding: the default's
+    // unaligned copies were still in flight when its 8-byte words were read back).
+    let point = |i: usize| {
         let (wp, normal) = (&w.points[i], h.points[i].normal_impulse);
         let (total_normal, max) = (wp.total_normal_impulse, wp.max_normal_impulse);
         let (was_stick, fresh) = (M4::from_bools(cold.stick[i]), M4::from_bools(cold.fresh[i]));
@@ -1016,25 +1014,30 @@ pub(crate) fn store_group<S: StateRead>(
         let released = zero.ge(max) | (fresh & bounced);
         let kept = normal.lt(F4::splat(0.5) * wp.preload).select(zero, wp.preload);
         let preload = released.select(zero, fresh.select(normal, kept));
-        for (l, o) in out.iter_mut().enumerate() {
-            o.points[i] = PointState {
-                normal_impulse: normal[l],
-                tangent_impulse: tangent[l],
-                total_normal_impulse: total_normal[l],
-                total_tangent_impulse: total_tangent_out[l],
-                max_normal_impulse: max[l],
-                state: if stick.lane(l) {
-                    FrictionState::Stick
-                } else {
-                    FrictionState::Slip
-                },
-                fresh: false,
-                drift: drift[l],
-                slip_speed: slip_speed[l],
-                preload: preload[l],
-            };
-        }
-    }
+        let lane = |l: usize| PointState {
+            normal_impulse: normal[l],
+            tangent_impulse: tangent[l],
+            total_normal_impulse: total_normal[l],
+            total_tangent_impulse: total_tangent_out[l],
+            max_normal_impulse: max[l],
+            state: if stick.lane(l) {
+                FrictionState::Stick
+            } else {
+                FrictionState::Slip
+            },
+            fresh: false,
+            drift: drift[l],
+            slip_speed: slip_speed[l],
+            preload: preload[l],
+        };
+        [lane(0), lane(1), lane(2), lane(3)]
+    };
+    let points = [point(0), point(1)];
+    core::array::from_fn(|l| StoredContact {
+        points: [points[0][l], points[1][l]],
+        rolling_impulse: h.rolling_impulse[l],
+        count: cold.count[l].min(2),
+    })
 }
 
 /// Copies a scalar constraint into lane `l` (everything: geometry, masses, state).
@@ -1497,8 +1500,7 @@ mod tests {
                 s
             })
             .collect();
-        let mut out = [StoredContact::default(); LANES];
-        store_group(&h, &w, &cold, &moved, &f.ctx, &mut out);
+        let out = store_group(&h, &w, &cold, &moved, &f.ctx);
         let (mut slipped, mut pushed) = (false, false);
         for l in 0..3 {
             let cc = unpack_full(&h, &w, &cold, &f.soft, l);
