@@ -376,6 +376,20 @@ pub(crate) fn transpose(rows: [F4; LANES]) -> [F4; LANES] {
     )
 }
 
+/// Two pairs of 2D points, each pair four consecutive floats `[x0, y0, x1, y1]`, as the
+/// lanes `([p.x0, p.x1, q.x0, q.x1], [p.y0, p.y1, q.y0, q.y1])` (four shuffles).
+#[inline(always)]
+pub(crate) fn split_xy(p: [f32; LANES], q: [f32; LANES]) -> (F4, F4) {
+    simd!(
+        {
+            let (a, b) = (sse::f(F4::new(p)), sse::f(F4::new(q)));
+            let (t0, t1) = (_mm_unpacklo_ps(a, b), _mm_unpackhi_ps(a, b));
+            (sse::to_f(_mm_unpacklo_ps(t0, t1)), sse::to_f(_mm_unpackhi_ps(t0, t1)))
+        },
+        (F4::new([p[0], p[2], q[0], q[2]]), F4::new([p[1], p[3], q[1], q[3]]))
+    )
+}
+
 #[inline(always)]
 fn mask(b: bool) -> u32 {
     if b {
@@ -596,6 +610,14 @@ impl Sub for V4 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `split_xy` gathers the x and the y of two interleaved pairs of points.
+    #[test]
+    fn split_xy_gathers_the_coordinates_of_two_pairs() {
+        let (x, y) = split_xy([1.0, 2.0, 3.0, 4.0], [5.0, 6.0, 7.0, 8.0]);
+        assert_eq!(*x, [1.0, 3.0, 5.0, 7.0]);
+        assert_eq!(*y, [2.0, 4.0, 6.0, 8.0]);
+    }
 
     #[test]
     fn lanes_match_scalar_arithmetic() {

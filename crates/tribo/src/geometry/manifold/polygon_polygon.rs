@@ -65,7 +65,16 @@ impl LocalPoly {
             let (v, n) = (&p.vertices, &p.normals);
             let z = Vec2::ZERO;
             return LocalPoly {
-                v: [xf.apply(v[0]), xf.apply(v[1]), xf.apply(v[2]), xf.apply(v[3]), z, z, z, z],
+                v: [
+                    xf.apply(v[0]),
+                    xf.apply(v[1]),
+                    xf.apply(v[2]),
+                    xf.apply(v[3]),
+                    z,
+                    z,
+                    z,
+                    z,
+                ],
                 n: [
                     xf.q.rotate(n[0]),
                     xf.q.rotate(n[1]),
