@@ -7,8 +7,8 @@
 use crate::dynamics::MixedMaterial;
 use crate::geometry::LINEAR_SLOP;
 use crate::geometry::{collide_bounded, Manifold, Shape, MAX_MANIFOLD_POINTS};
+use crate::math::wide::{split_xy, F4, M4};
 use crate::math::{Rot, Transform, Vec2};
-use crate::solver::wide::{split_xy, F4, M4};
 use crate::world::ShapeId;
 
 /// Friction state of one contact point.

@@ -6,6 +6,8 @@
 //! All arithmetic is plain `f32` with no fused multiply-add, so a given build produces
 //! bit-identical results run after run.
 
+pub(crate) mod wide;
+
 use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 
 /// A 2D vector or point [m] (or [m/s], [N], ... by context).

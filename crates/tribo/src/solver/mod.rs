@@ -24,7 +24,7 @@ pub(crate) mod contact_solver;
 pub(crate) mod contact_wide;
 pub(crate) mod joint_solver;
 pub(crate) mod softness;
-pub(crate) mod wide;
+pub(crate) use crate::math::wide;
 
 use crate::math::{Rot, Vec2};
 use crate::world::{Profile, Stopwatch};

@@ -1,4 +1,5 @@
-//! Four-lane floats for the wide contact solver.
+//! Four-lane floats: the wide contact solver's lanes, and the few four-wide steps of
+//! manifold recycling and polygon collision.
 //!
 //! `F4` is four `f32` lanes; every operation is lane-wise plain IEEE arithmetic (no fused
 //! multiply-add, no approximate reciprocal), so a lane computes bit for bit what the same
