@@ -1035,17 +1035,17 @@ impl ContactSolver {
             let (Some(lanes), Some(&colour)) = (self.lane_candidates.get(g), self.group_colour.get(g)) else {
                 continue;
             };
-            for ((s, &cand), &contact) in out.iter().zip(lanes).zip(&cold.contact) {
+            for (l, (&cand, &contact)) in lanes.iter().zip(&cold.contact).enumerate() {
                 if cand == u32::MAX {
                     continue; // an empty lane
                 }
                 match contacts.get_mut(at(contact)) {
                     Some(Some(c)) => {
-                        s.write_into(c);
+                        out.write_into(l, c);
                         c.colour = colour;
                     }
                     Some(None) => {}
-                    None => strays.push((contact, colour, *s)),
+                    None => strays.push((contact, colour, out.lane(l))),
                 }
             }
         }

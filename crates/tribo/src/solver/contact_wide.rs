@@ -954,14 +954,15 @@ impl StoredContact {
 /// The store stage for four constraints, in group order: exactly what
 /// `contact_solver::store_impulses` computes for each lane (the end-of-step slip velocity
 /// and anchor displacement four lanes at a time, the sums and the stick/slip transitions
-/// lane by lane), written to `out` for the contacts to copy in contact order.
+/// lane by lane), as lanes for the contacts to take in contact order
+/// ([`StoredGroup::write_into`]).
 pub(crate) fn store_group<S: StateRead>(
     h: &WideHead,
     w: &WideContact,
     cold: &WideCold,
     states: &[S],
     ctx: &StepContext,
-) -> [StoredContact; LANES] {
+) -> StoredGroup {
     let a = gather(states, &h.index_a);
     let b = gather(states, &h.index_b);
     let d = b.dp - a.dp;
@@ -996,9 +997,11 @@ pub(crate) fn store_group<S: StateRead>(
     let stick_speed = F4::splat(ctx.stick_speed);
     let restitution = F4::new(cold.restitution);
     let threshold = -F4::new(cold.restitution_threshold);
-    // Each point's states, four lanes; the output is built from them at the end (filling
-    // a default-made array field by field stalled on store forwarding: the default's
-    // unaligned copies were still in flight when its 8-byte words were read back).
+    // Each point's states, four lanes, kept as lanes: each contact's point states are
+    // written from them field by field in its own record, not built lane by lane into an
+    // array on the stack first and copied (filling a default-made array field by field had
+    // also stalled on store forwarding: the default's unaligned copies were still in
+    // flight when its 8-byte words were read back).
     let point = |i: usize| {
         let (wp, normal) = (&w.points[i], h.points[i].normal_impulse);
         let (total_normal, max) = (wp.total_normal_impulse, wp.max_normal_impulse);
@@ -1022,30 +1025,91 @@ pub(crate) fn store_group<S: StateRead>(
         let released = zero.ge(max) | (fresh & bounced);
         let kept = normal.lt(F4::splat(0.5) * wp.preload).select(zero, wp.preload);
         let preload = released.select(zero, fresh.select(normal, kept));
-        let lane = |l: usize| PointState {
-            normal_impulse: normal[l],
-            tangent_impulse: tangent[l],
-            total_normal_impulse: total_normal[l],
-            total_tangent_impulse: total_tangent_out[l],
-            max_normal_impulse: max[l],
-            state: if stick.lane(l) {
+        StoredPoint {
+            normal,
+            total_normal,
+            total_tangent: total_tangent_out,
+            max,
+            stick,
+            drift,
+            slip_speed,
+            preload,
+        }
+    };
+    StoredGroup {
+        points: [point(0), point(1)],
+        tangent,
+        rolling_impulse: h.rolling_impulse,
+        count: cold.count,
+    }
+}
+
+/// One point's stored states in the four lanes of a group ([`store_group`]).
+pub(crate) struct StoredPoint {
+    normal: F4,
+    total_normal: F4,
+    total_tangent: F4,
+    max: F4,
+    stick: M4,
+    drift: F4,
+    slip_speed: F4,
+    preload: F4,
+}
+
+/// What the store writes into a group's four contacts, as lanes ([`store_group`]).
+pub(crate) struct StoredGroup {
+    points: [StoredPoint; 2],
+    /// Each point's friction impulse (the row's, shared by the points).
+    tangent: F4,
+    rolling_impulse: F4,
+    /// The manifolds' point counts.
+    count: [u8; LANES],
+}
+
+impl StoredGroup {
+    /// Point `i`'s state in lane `l`.
+    #[inline(always)]
+    fn point(&self, i: usize, l: usize) -> PointState {
+        let p = &self.points[i];
+        PointState {
+            normal_impulse: p.normal[l],
+            tangent_impulse: self.tangent[l],
+            total_normal_impulse: p.total_normal[l],
+            total_tangent_impulse: p.total_tangent[l],
+            max_normal_impulse: p.max[l],
+            state: if p.stick.lane(l) {
                 FrictionState::Stick
             } else {
                 FrictionState::Slip
             },
             fresh: false,
-            drift: drift[l],
-            slip_speed: slip_speed[l],
-            preload: preload[l],
-        };
-        [lane(0), lane(1), lane(2), lane(3)]
-    };
-    let points = [point(0), point(1)];
-    core::array::from_fn(|l| StoredContact {
-        points: [points[0][l], points[1][l]],
-        rolling_impulse: h.rolling_impulse[l],
-        count: cold.count[l].min(2),
-    })
+            drift: p.drift[l],
+            slip_speed: p.slip_speed[l],
+            preload: p.preload[l],
+        }
+    }
+
+    /// Writes lane `l` into its contact (the manifold's points and the rolling impulse).
+    #[inline(always)]
+    pub(crate) fn write_into(&self, l: usize, c: &mut Contact) {
+        let count = self.count[l].min(2);
+        if count >= 1 {
+            c.points[0] = self.point(0, l);
+        }
+        if count >= 2 {
+            c.points[1] = self.point(1, l);
+        }
+        c.rolling_impulse = self.rolling_impulse[l];
+    }
+
+    /// Lane `l` as a record of its own (for a contact written later, on one thread).
+    pub(crate) fn lane(&self, l: usize) -> StoredContact {
+        StoredContact {
+            points: [self.point(0, l), self.point(1, l)],
+            rolling_impulse: self.rolling_impulse[l],
+            count: self.count[l].min(2),
+        }
+    }
 }
 
 /// Copies a scalar constraint into lane `l` (everything: geometry, masses, state).
@@ -1508,7 +1572,8 @@ mod tests {
                 s
             })
             .collect();
-        let out = store_group(&h, &w, &cold, &moved, &f.ctx);
+        let stored = store_group(&h, &w, &cold, &moved, &f.ctx);
+        let out: [StoredContact; LANES] = core::array::from_fn(|l| stored.lane(l));
         let (mut slipped, mut pushed) = (false, false);
         for l in 0..3 {
             let cc = unpack_full(&h, &w, &cold, &f.soft, l);
