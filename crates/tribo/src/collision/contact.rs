@@ -452,6 +452,16 @@ mod tests {
         assert!(!c.recycle(xf_g, Transform::new(Vec2::new(0.306, 0.499), 0.0), 2.0 * 0.71));
     }
 
+    /// A ground box (top face y = 0), a disk of radius 0.5 m and the ground's pose.
+    fn disk_and_ground() -> (Shape, Shape, Transform) {
+        let ground = Shape::Polygon(Polygon::new_box(5.0, 0.5).unwrap());
+        let disk = Shape::Circle(Circle {
+            center: Vec2::ZERO,
+            radius: 0.5,
+        });
+        (ground, disk, Transform::new(Vec2::new(0.0, -0.5), 0.0))
+    }
+
     /// The check runs four lanes (two points of each side) whatever the manifold's count:
     /// a one-point manifold (a disk resting on the ground) must recycle when it moves
     /// within the slop even when its basis's unused second slot holds points metres away
@@ -459,12 +469,7 @@ mod tests {
     /// beyond the slop.
     #[test]
     fn a_one_point_manifold_ignores_the_unused_slot_of_its_basis() {
-        let ground = Shape::Polygon(Polygon::new_box(5.0, 0.5).unwrap());
-        let disk = Shape::Circle(Circle {
-            center: Vec2::ZERO,
-            radius: 0.5,
-        });
-        let xf_g = Transform::new(Vec2::new(0.0, -0.5), 0.0);
+        let (ground, disk, xf_g) = disk_and_ground();
         let mut c = contact();
         assert!(c.update(&ground, xf_g, &disk, Transform::new(Vec2::new(0.0, 0.499), 0.0), 0.02));
         assert_eq!(c.manifold.count, 1);
@@ -490,12 +495,7 @@ mod tests {
     /// so the manifold must be computed again; so must a box tipped by 0.5°.
     #[test]
     fn rolling_or_turning_contacts_are_not_recycled() {
-        let ground = Shape::Polygon(Polygon::new_box(5.0, 0.5).unwrap());
-        let disk = Shape::Circle(Circle {
-            center: Vec2::ZERO,
-            radius: 0.5,
-        });
-        let xf_g = Transform::new(Vec2::new(0.0, -0.5), 0.0);
+        let (ground, disk, xf_g) = disk_and_ground();
         let mut c = contact();
         assert!(c.update(&ground, xf_g, &disk, Transform::new(Vec2::new(0.0, 0.5), 0.0), 0.02));
         let rolled = Transform::new(Vec2::new(0.02, 0.5), -0.04);
