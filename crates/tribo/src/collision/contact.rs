@@ -462,11 +462,12 @@ mod tests {
         (ground, disk, Transform::new(Vec2::new(0.0, -0.5), 0.0))
     }
 
-    /// The check runs four lanes (two points of each side) whatever the manifold's count:
-    /// a one-point manifold (a disk resting on the ground) must recycle when it moves
-    /// within the slop even when its basis's unused second slot holds points metres away
-    /// (a stale basis of an earlier two-point manifold), and must still refuse a move
-    /// beyond the slop.
+    /// The check runs four lanes (two points of each side) whatever the manifold's count,
+    /// so a one-point manifold must mask the lanes of its unused slot: even zero there is
+    /// a point at a body's origin, which moves as the body turns (and would, unmasked,
+    /// refuse recycling by the distance between the origins). A disk resting on the
+    /// ground must recycle when it moves within the slop with points metres away in that
+    /// slot, and still refuse a move beyond the slop.
     #[test]
     fn a_one_point_manifold_ignores_the_unused_slot_of_its_basis() {
         let (ground, disk, xf_g) = disk_and_ground();

@@ -1583,6 +1583,11 @@ mod tests {
             assert_eq!(out[l].count as usize, n);
             assert_eq!(out[l].points[..n], c.points[..n], "lane {l}");
             assert_eq!(out[l].rolling_impulse.to_bits(), c.rolling_impulse.to_bits());
+            // What the store stage calls: the lane written straight into a contact.
+            let mut written = crate::collision::contact::blank_contact();
+            stored.write_into(l, &mut written);
+            assert_eq!(written.points[..n], c.points[..n], "lane {l} written");
+            assert_eq!(written.rolling_impulse.to_bits(), c.rolling_impulse.to_bits());
             slipped |= c.points[..n].iter().any(|p| p.state == FrictionState::Slip);
             pushed |= c.points[..n]
                 .iter()
