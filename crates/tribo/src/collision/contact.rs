@@ -239,7 +239,7 @@ impl Contact {
     /// `reach_a`, `reach_b`: the bodies' largest distance [m] from their origin to a shape
     /// point. When true, colliding would give the empty manifold the contact already has
     /// (see `geometry::collide_bounded`).
-    #[inline]
+    #[inline(always)]
     pub fn still_apart(&self, d: Vec2, q_a: Rot, q_b: Rot, reach_a: f32, reach_b: f32, margin: f32) -> bool {
         let Memo::Far { bound, poses: f } = &self.memo else {
             return false;

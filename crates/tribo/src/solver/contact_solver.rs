@@ -248,6 +248,7 @@ impl ContactInput {
     }
 
     /// Writes what building a constraint reads of contact `c` in place (no copy).
+    #[inline(always)]
     pub fn fill(&mut self, c: &Contact) {
         self.normal = c.manifold.normal;
         self.count = c.manifold.count.min(2);
