@@ -225,6 +225,7 @@ mod sse {
         _mm_cmpgt_ps(a: __m128, b: __m128) -> __m128;
         _mm_cmpge_ps(a: __m128, b: __m128) -> __m128;
         _mm_cmplt_ps(a: __m128, b: __m128) -> __m128;
+        _mm_cmpneq_ps(a: __m128, b: __m128) -> __m128;
         _mm_movemask_ps(a: __m128) -> i32;
         _mm_unpacklo_ps(a: __m128, b: __m128) -> __m128;
         _mm_unpackhi_ps(a: __m128, b: __m128) -> __m128;
@@ -351,6 +352,15 @@ impl F4 {
         simd!(
             sse::to_m(_mm_cmplt_ps(sse::f(self), sse::f(o))),
             M4::new(lanes!(|i| mask(self[i] < o[i])))
+        )
+    }
+
+    /// Lane-wise `!=` (true where either lane is NaN, as the scalar `!=`).
+    #[inline(always)]
+    pub fn ne(self, o: F4) -> M4 {
+        simd!(
+            sse::to_m(_mm_cmpneq_ps(sse::f(self), sse::f(o))),
+            M4::new(lanes!(|i| mask(self[i] != o[i])))
         )
     }
 }

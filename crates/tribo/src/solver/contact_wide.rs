@@ -819,6 +819,15 @@ pub(crate) fn build_group<S: StateRead>(
     if warm {
         hd.rolling_impulse = rolling_impulse;
     }
+    // The group's flags and the points' heights, four lanes at once from the columns (an
+    // empty lane's zeros set no flag and give the height 0): the scalar tests and the
+    // height's `dot`, lane by lane.
+    let any_restitution = restitution.gt(zero).any();
+    (c.any_restitution, hd.any_restitution) = (any_restitution, any_restitution);
+    let used_rolling_impulse = if warm { rolling_impulse } else { zero };
+    hd.any_rolling = (rolling_resistance.gt(zero) | used_rolling_impulse.ne(zero)).any();
+    let height = point_rows[0][0] * F4::splat(up.x) + point_rows[0][1] * F4::splat(up.y);
+    c.height = *has[0].select(height, zero);
     for (l, lane) in lanes.iter().enumerate() {
         let Some((contact, input, b)) = *lane else {
             // An empty lane: nothing but a sticking, empty friction row.
@@ -828,15 +837,10 @@ pub(crate) fn build_group<S: StateRead>(
         let count = count_of(input);
         c.contact[l] = contact;
         c.count[l] = count as u8;
-        c.any_restitution |= input.restitution > 0.0;
-        hd.any_restitution |= input.restitution > 0.0;
-        c.height[l] = if count > 0 { input.points[0].point.dot(up) } else { 0.0 };
         hd.index_a[l] = b.index_a;
         hd.index_b[l] = b.index_b;
         hd.write_a[l] = (b.inv_mass_a > 0.0 || b.inv_i_a > 0.0) && b.index_a != 0;
         hd.write_b[l] = (b.inv_mass_b > 0.0 || b.inv_i_b > 0.0) && b.index_b != 0;
-        let rolling_impulse = if warm { input.rolling_impulse } else { 0.0 };
-        hd.any_rolling |= input.rolling_resistance > 0.0 || rolling_impulse != 0.0;
         let states_ab = input.points[..count]
             .iter()
             .any(|p| p.fresh)
@@ -1485,6 +1489,39 @@ mod tests {
             (0.0, 0.0, 0.0)
         );
         assert!(h.any_rolling && cold.any_restitution && w.block.lane(0));
+    }
+
+    /// The group's flags are set from its lanes' columns: none without restitution or a
+    /// rolling row in any lane (the fixture's lanes all have a rolling impulse), each one
+    /// by the one lane that has it, wherever that lane is; the heights are the first
+    /// points' along `up`, zero in empty lanes.
+    #[test]
+    fn group_flags_and_heights_come_from_their_lanes() {
+        let f = fixture();
+        let (id, b) = (f.cases[0].0, &f.cases[0].2);
+        let mut plain = f.cases[0].1;
+        plain.rolling_impulse = 0.0;
+        let (mut rolling, mut bouncy, mut resisting) = (plain, plain, plain);
+        rolling.rolling_impulse = 0.01;
+        bouncy.restitution = 0.4;
+        resisting.rolling_resistance = 0.05;
+        // (lane input, its lane, flags expected: restitution, rolling)
+        for (input, lane, expected) in [
+            (&plain, 0, (false, false)),
+            (&rolling, 3, (false, true)),
+            (&bouncy, 2, (true, false)),
+            (&resisting, 1, (false, true)),
+        ] {
+            let mut lanes: [LaneInput<'_>; LANES] = [None; LANES];
+            lanes[lane] = Some((id, input, b));
+            let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
+            build_group(&mut h, &mut w, &mut cold, lanes, f.up, &f.ctx, &f.states);
+            assert_eq!((h.any_restitution, h.any_rolling), expected, "lane {lane}");
+            assert_eq!(cold.any_restitution, expected.0);
+            let height = input.points[0].point.dot(f.up);
+            let heights: [f32; LANES] = core::array::from_fn(|l| if l == lane { height } else { 0.0 });
+            assert_eq!(cold.height, heights);
+        }
     }
 
     /// A group whose lanes all have one point takes the solve's one-point path, which skips
