@@ -746,12 +746,16 @@ impl ContactSolver {
         // Whether the candidates in `range` are laid out as last step; their light bodies
         // into `out`.
         let check = |range: core::ops::Range<usize>, out: &mut Vec<(u32, u32)>| {
-            for i in range {
-                let (Some(&contact), Some(&last_contact), Some(last)) =
-                    (candidates.list.get(i), self.contact_of.get(i), self.last_keys.get(i))
-                else {
-                    return false;
-                };
+            // The three lists side by side over `range` (one bounds check each, not three
+            // per candidate).
+            let (Some(list), Some(contact_of), Some(last_keys)) = (
+                candidates.list.get(range.clone()),
+                self.contact_of.get(range.clone()),
+                self.last_keys.get(range.clone()),
+            ) else {
+                return false;
+            };
+            for (i, ((&contact, &last_contact), last)) in list.iter().zip(contact_of).zip(last_keys).enumerate() {
                 let Some(key) = candidates.keys.get(contact as usize) else {
                     return false;
                 };
@@ -764,7 +768,7 @@ impl ContactSolver {
                     return false;
                 }
                 if key.flags & KEY_RATIO != 0 {
-                    out.extend(candidates.get(i).and_then(|cand| self.light_body(cand, sims)));
+                    out.extend(candidates.get(range.start + i).and_then(|cand| self.light_body(cand, sims)));
                 }
             }
             true
