@@ -1,7 +1,7 @@
 //! Shape types. All coordinates are in the body's local frame [m].
 
 use super::{GeometryError, LINEAR_SLOP};
-use crate::math::wide::{bounds_of_four, split_xy, F4};
+use crate::math::wide::{bounds_of_points, split_xy, F4};
 use crate::math::{Aabb, Transform, Vec2};
 
 /// Most vertices a polygon may have (Box2D v3 uses 8).
@@ -385,17 +385,33 @@ impl Shape {
                 let b = xf.apply(s.point2);
                 Aabb::new(a.min(b), a.max(b))
             }
-            Shape::Polygon(p) if p.count() == 4 => {
-                // A box: the four vertices as lanes (the scalar fold's bits, below), for
-                // every moving box every step (large_pyramid: 125 instructions a call).
-                let v = &p.vertices;
-                let (x, y) = split_xy([v[0].x, v[0].y, v[1].x, v[1].y], [v[2].x, v[2].y, v[3].x, v[3].y]);
+            Shape::Polygon(p) if p.count() > 0 => {
+                // The vertices as lanes, four a group (slots past the count padded with
+                // vertex 0), transformed and folded in the scalar fold's order with its
+                // ties (`bounds_of_points`: the same bits as the fold below), for every
+                // moving polygon every step: a box took 125 instructions a call as scalar
+                // code (large_pyramid), an eight-sided one about 300 (junkyard).
+                let (n, v) = (p.count(), &p.vertices);
+                let at = |i: usize| if i < n { v[i] } else { v[0] };
                 let (q, t) = (xf.q, xf.p);
-                let (c, s) = (F4::splat(q.c), F4::splat(q.s));
+                let (c, s, tx, ty) = (F4::splat(q.c), F4::splat(q.s), F4::splat(t.x), F4::splat(t.y));
                 // `Transform::apply` lane by lane: (c x − s y) + p.x, (s x + c y) + p.y.
-                let wx = c * x - s * y + F4::splat(t.x);
-                let wy = s * x + c * y + F4::splat(t.y);
-                let (lo, hi) = bounds_of_four(wx, wy);
+                let group = |k: usize| {
+                    let [a, b, c2, d] = [at(k), at(k + 1), at(k + 2), at(k + 3)];
+                    let (x, y) = split_xy([a.x, a.y, b.x, b.y], [c2.x, c2.y, d.x, d.y]);
+                    (c * x - s * y + tx, s * x + c * y + ty)
+                };
+                let (lo, hi) = if n == 4 {
+                    // A box: no slot to pad (its own branch, so none is tested).
+                    let (x, y) = split_xy([v[0].x, v[0].y, v[1].x, v[1].y], [v[2].x, v[2].y, v[3].x, v[3].y]);
+                    bounds_of_points([c * x - s * y + tx], [s * x + c * y + ty])
+                } else if n < 4 {
+                    let (x, y) = group(0);
+                    bounds_of_points([x], [y])
+                } else {
+                    let ((x0, y0), (x1, y1)) = (group(0), group(4));
+                    bounds_of_points([x0, x1], [y0, y1])
+                };
                 Aabb::new(Vec2::new(lo[0], lo[1]), Vec2::new(hi[0], hi[1])).expand(p.radius)
             }
             Shape::Polygon(p) => {
@@ -632,12 +648,13 @@ mod tests {
         assert_eq!(cap.centroid(), Vec2::ZERO);
     }
 
-    /// A box's box is computed four lanes at a time; it must be the scalar fold's, bit for
-    /// bit (the broad phase and every trajectory depend on it): the same sums in the same
-    /// order, and on a tie the running value kept, down to the sign of a zero. The
-    /// reference is the fold every other polygon takes.
+    /// A polygon's box is computed four vertices a lane vector; it must be the scalar
+    /// fold's, bit for bit (the broad phase and every trajectory depend on it): the same
+    /// sums in the same order, and on a tie the running value kept, down to the sign of a
+    /// zero. The reference is the fold over the vertices in order; the cases are boxes and
+    /// polygons of 3 to 8 vertices.
     #[test]
-    fn a_box_aabb_is_the_scalar_folds_bits() {
+    fn a_polygon_aabb_is_the_scalar_folds_bits() {
         let fold = |p: &Polygon, xf: Transform| {
             let w: Vec<Vec2> = p.vertices().iter().map(|&v| xf.apply(v)).collect();
             let (mut lo, mut hi) = (w[0], w[0]);
@@ -659,6 +676,29 @@ mod tests {
             let xf = Transform::new(v(20.0 * next() - 10.0, 20.0 * next() - 10.0), 7.0 * next() - 3.5);
             cases.push((p, xf));
         }
+        let mut sizes = [0usize; MAX_POLYGON_VERTICES + 1];
+        for k in 0..1200 {
+            // Points spread round a circle (every third polygon regular: exact ties).
+            let n = 3 + k % (MAX_POLYGON_VERTICES - 2);
+            let jitter = if k % 3 == 0 { 0.0 } else { 0.3 };
+            let points: Vec<Vec2> = (0..n)
+                .map(|i| {
+                    let a = (i as f32 + jitter * next()) * core::f32::consts::TAU / n as f32;
+                    v(a.cos(), a.sin()) * (0.5 + 0.2 * next())
+                })
+                .collect();
+            let Ok(p) = Polygon::from_points(&points, 0.05 * next()) else {
+                continue;
+            };
+            sizes[p.count()] += 1;
+            let xf = Transform::new(v(20.0 * next() - 10.0, 20.0 * next() - 10.0), 7.0 * next() - 3.5);
+            cases.push((p, xf));
+            cases.push((p, Transform::IDENTITY));
+        }
+        assert!(
+            sizes[3..].iter().all(|&m| m > 20),
+            "every vertex count is covered: {sizes:?}"
+        );
         // Ties of signed zeros: a box with two vertices on x = 0, turned by exactly a half
         // turn (c = −1, s = ±0) and moved by −0: one of those vertices lands on x = −0 and
         // the other on x = +0, both the smallest x (on the largest side the radius added,

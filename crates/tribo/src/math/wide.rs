@@ -401,31 +401,56 @@ pub(crate) fn split_xy(p: [f32; LANES], q: [f32; LANES]) -> (F4, F4) {
     )
 }
 
-/// The bounds `(min, max)`, as `[x, y]`, of four points given as lanes of x and of y: bit
-/// for bit what the scalar fold from point 0 gives (`lo = lo.min(p)`, `hi = hi.max(p)` for
-/// points 1, 2, 3 in order), a tie keeping the running value as `f32::min` and `f32::max`
-/// keep their receiver (so the sign of a zero is the scalar's too). For finite lanes: where
-/// the running value is NaN, `f32::min` takes the point and this keeps the NaN.
+/// The bounds `(min, max)`, as `[x, y]`, of `4 GROUPS` points given as lanes of x and of y,
+/// four points a group (`x[g][k]` is point 4g + k): bit for bit what the scalar fold from
+/// point 0 gives (`lo = lo.min(p)`, `hi = hi.max(p)` for the points after it in order), a
+/// tie keeping the running value as `f32::min` and `f32::max` keep their receiver (so the
+/// sign of a zero is the scalar's too). Fewer points are padded with copies of point 0:
+/// a repeat of point 0 changes no bound, not even on a tie (the running bound is never
+/// beyond it). For finite lanes: where the running value is NaN, `f32::min` takes the
+/// point and this keeps the NaN.
 #[inline(always)]
-pub(crate) fn bounds_of_four(x: F4, y: F4) -> ([f32; 2], [f32; 2]) {
+pub(crate) fn bounds_of_points<const GROUPS: usize>(x: [F4; GROUPS], y: [F4; GROUPS]) -> ([f32; 2], [f32; 2]) {
     simd!(
         {
-            let (x, y) = (sse::f(x), sse::f(y));
-            // [x0, y0, x1, y1] and [x2, y2, x3, y3]; points 1 and 3 moved to lanes 0 and 1.
-            let (p01, p23) = (_mm_unpacklo_ps(x, y), _mm_unpackhi_ps(x, y));
-            let (p1, p3) = (_mm_movehl_ps(p01, p01), _mm_movehl_ps(p23, p23));
+            // Each point as the pair (x, y) in lanes 0 and 1: [x0, y0, x1, y1] and
+            // [x2, y2, x3, y3] per group, points 1 and 3 moved down to lanes 0 and 1.
+            let first = _mm_unpacklo_ps(sse::f(x[0]), sse::f(y[0]));
+            let (mut lo, mut hi) = (first, first);
             // `minps(p, acc)` is `p < acc ? p : acc`: the running value stays on a tie.
-            let lo = _mm_min_ps(p3, _mm_min_ps(p23, _mm_min_ps(p1, p01)));
-            let hi = _mm_max_ps(p3, _mm_max_ps(p23, _mm_max_ps(p1, p01)));
+            let mut take = |p| {
+                lo = _mm_min_ps(p, lo);
+                hi = _mm_max_ps(p, hi);
+            };
+            for g in 0..GROUPS {
+                let (x, y) = (sse::f(x[g]), sse::f(y[g]));
+                let (p01, p23) = (_mm_unpacklo_ps(x, y), _mm_unpackhi_ps(x, y));
+                if g > 0 {
+                    take(p01);
+                }
+                take(_mm_movehl_ps(p01, p01));
+                take(p23);
+                take(_mm_movehl_ps(p23, p23));
+            }
             let (lo, hi) = (sse::to_f(lo), sse::to_f(hi));
             ([lo[0], lo[1]], [hi[0], hi[1]])
         },
         {
-            let fold = |v: F4, less: fn(f32, f32) -> bool| {
-                (1..LANES).fold(v[0], |acc, i| if less(v[i], acc) { v[i] } else { acc })
+            let lane = |v: &[F4; GROUPS], i: usize| v[i / LANES][i % LANES];
+            let fold = |v: &[F4; GROUPS], less: fn(f32, f32) -> bool| {
+                (1..LANES * GROUPS).fold(
+                    lane(v, 0),
+                    |acc, i| {
+                        if less(lane(v, i), acc) {
+                            lane(v, i)
+                        } else {
+                            acc
+                        }
+                    },
+                )
             };
             let (lt, gt): (fn(f32, f32) -> bool, fn(f32, f32) -> bool) = (|a, b| a < b, |a, b| a > b);
-            ([fold(x, lt), fold(y, lt)], [fold(x, gt), fold(y, gt)])
+            ([fold(&x, lt), fold(&y, lt)], [fold(&x, gt), fold(&y, gt)])
         }
     )
 }

@@ -768,7 +768,11 @@ impl ContactSolver {
                     return false;
                 }
                 if key.flags & KEY_RATIO != 0 {
-                    out.extend(candidates.get(range.start + i).and_then(|cand| self.light_body(cand, sims)));
+                    out.extend(
+                        candidates
+                            .get(range.start + i)
+                            .and_then(|cand| self.light_body(cand, sims)),
+                    );
                 }
             }
             true
