@@ -402,7 +402,7 @@ impl Shape {
                     (c * x - s * y + tx, s * x + c * y + ty)
                 };
                 let (lo, hi) = if n == 4 {
-                    // A box: no slot to pad (its own branch, so none is tested).
+                    // Four vertices (every box): no slot to pad, so no `i < n` selects.
                     let (x, y) = split_xy([v[0].x, v[0].y, v[1].x, v[1].y], [v[2].x, v[2].y, v[3].x, v[3].y]);
                     bounds_of_points([c * x - s * y + tx], [s * x + c * y + ty])
                 } else if n < 4 {
@@ -651,11 +651,24 @@ mod tests {
     /// A polygon's box is computed four vertices a lane vector; it must be the scalar
     /// fold's, bit for bit (the broad phase and every trajectory depend on it): the same
     /// sums in the same order, and on a tie the running value kept, down to the sign of a
-    /// zero. The reference is the fold over the vertices in order; the cases are boxes and
-    /// polygons of 3 to 8 vertices.
+    /// zero. The reference is the fold over the vertices in order with that tie rule
+    /// written out; on x86-64 it is also what the old code's `f32::min`/`f32::max` fold
+    /// gives, checked here too. The cases: boxes, polygons of 3 to 8 vertices around the
+    /// body origin and away from it (there the slots past the count, zeros, would be
+    /// outliers if read), regular ones, and signed-zero ties for every vertex count.
     #[test]
     fn a_polygon_aabb_is_the_scalar_folds_bits() {
         let fold = |p: &Polygon, xf: Transform| {
+            let w: Vec<Vec2> = p.vertices().iter().map(|&v| xf.apply(v)).collect();
+            let (mut lo, mut hi) = (w[0], w[0]);
+            let keep = |acc: f32, q: f32, better: bool| if better { q } else { acc };
+            for &q in &w[1..] {
+                lo = Vec2::new(keep(lo.x, q.x, q.x < lo.x), keep(lo.y, q.y, q.y < lo.y));
+                hi = Vec2::new(keep(hi.x, q.x, q.x > hi.x), keep(hi.y, q.y, q.y > hi.y));
+            }
+            Aabb::new(lo, hi).expand(p.radius)
+        };
+        let std_fold = |p: &Polygon, xf: Transform| {
             let w: Vec<Vec2> = p.vertices().iter().map(|&v| xf.apply(v)).collect();
             let (mut lo, mut hi) = (w[0], w[0]);
             for &q in &w[1..] {
@@ -678,13 +691,20 @@ mod tests {
         }
         let mut sizes = [0usize; MAX_POLYGON_VERTICES + 1];
         for k in 0..1200 {
-            // Points spread round a circle (every third polygon regular: exact ties).
+            // Points spread round a circle about the origin or about (3, 3); every third
+            // polygon regular (equal coordinates: ties of equal values).
             let n = 3 + k % (MAX_POLYGON_VERTICES - 2);
-            let jitter = if k % 3 == 0 { 0.0 } else { 0.3 };
+            let regular = k % 3 == 0;
+            let centre = if k % 2 == 0 { Vec2::ZERO } else { v(3.0, 3.0) };
             let points: Vec<Vec2> = (0..n)
                 .map(|i| {
-                    let a = (i as f32 + jitter * next()) * core::f32::consts::TAU / n as f32;
-                    v(a.cos(), a.sin()) * (0.5 + 0.2 * next())
+                    let (jitter, r) = if regular {
+                        (0.0, 0.5)
+                    } else {
+                        (0.3 * next(), 0.5 + 0.2 * next())
+                    };
+                    let a = (i as f32 + jitter) * core::f32::consts::TAU / n as f32;
+                    centre + v(a.cos(), a.sin()) * r
                 })
                 .collect();
             let Ok(p) = Polygon::from_points(&points, 0.05 * next()) else {
@@ -699,24 +719,51 @@ mod tests {
             sizes[3..].iter().all(|&m| m > 20),
             "every vertex count is covered: {sizes:?}"
         );
-        // Ties of signed zeros: a box with two vertices on x = 0, turned by exactly a half
-        // turn (c = −1, s = ±0) and moved by −0: one of those vertices lands on x = −0 and
-        // the other on x = +0, both the smallest x (on the largest side the radius added,
-        // +0, would make either zero +0). Flipping the sign of s swaps which vertex is −0:
-        // the fold keeps the first either way, so the two boxes differ in that sign.
-        let mut signs = Vec::new();
+        // Ties of signed zeros: a polygon with two vertices on x = 0, its largest x, turned
+        // by exactly a half turn (c = −1, s = ±0) and moved by −0: one of those vertices
+        // lands on x = −0 and the other on x = +0, both the smallest x (on the largest
+        // side the radius added, +0, would make either zero +0). Flipping the sign of s
+        // swaps which vertex is −0: the fold keeps the first either way, so the two boxes
+        // differ in that sign. For 3 to 8 vertices (the two tied vertices fall in either
+        // lane group).
+        for n in 3..=MAX_POLYGON_VERTICES {
+            let mut points = vec![v(0.0, -1.0), v(0.0, 1.0)];
+            points.extend((0..n - 2).map(|i| {
+                let a = core::f32::consts::PI * (i as f32 + 1.0) / (n - 1) as f32;
+                v(-2.0 * a.sin(), -a.cos())
+            }));
+            let p = Polygon::from_points(&points, 0.0).unwrap();
+            assert_eq!(p.count(), n);
+            let mut signs = Vec::new();
+            for sign in [1.0, -1.0] {
+                let xf = Transform {
+                    p: v(-0.0, 0.0),
+                    q: Rot { c: -1.0, s: 0.0 * sign },
+                };
+                cases.push((p, xf));
+                let slow = fold(&p, xf);
+                assert_eq!(slow.min.x, 0.0);
+                signs.push(slow.min.x.is_sign_negative());
+            }
+            assert_ne!(
+                signs[0], signs[1],
+                "{n} vertices: the two ties must keep zeros of opposite signs"
+            );
+        }
+        // The box of a box: its own branch.
+        let p = Polygon::new_offset_box(1.0, 1.0, v(-1.0, 0.0), 0.0).unwrap();
         for sign in [1.0, -1.0] {
-            let p = Polygon::new_offset_box(1.0, 1.0, v(-1.0, 0.0), 0.0).unwrap();
             let xf = Transform {
                 p: v(-0.0, 0.0),
                 q: Rot { c: -1.0, s: 0.0 * sign },
             };
             cases.push((p, xf));
-            let slow = fold(&p, xf);
-            assert_eq!(slow.min.x, 0.0);
-            signs.push(slow.min.x.is_sign_negative());
         }
-        assert_ne!(signs[0], signs[1], "the two ties must keep zeros of opposite signs");
+        for (p, xf) in &cases {
+            if cfg!(target_arch = "x86_64") {
+                assert_eq!(bits(fold(p, *xf)), bits(std_fold(p, *xf)), "the old fold, {xf:?}");
+            }
+        }
         for (p, xf) in cases {
             let (fast, slow) = (Shape::Polygon(p).aabb(xf), fold(&p, xf));
             assert_eq!(bits(fast), bits(slow), "{xf:?}: {fast:?} vs {slow:?}");

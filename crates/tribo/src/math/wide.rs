@@ -402,13 +402,15 @@ pub(crate) fn split_xy(p: [f32; LANES], q: [f32; LANES]) -> (F4, F4) {
 }
 
 /// The bounds `(min, max)`, as `[x, y]`, of `4 GROUPS` points given as lanes of x and of y,
-/// four points a group (`x[g][k]` is point 4g + k): bit for bit what the scalar fold from
-/// point 0 gives (`lo = lo.min(p)`, `hi = hi.max(p)` for the points after it in order), a
-/// tie keeping the running value as `f32::min` and `f32::max` keep their receiver (so the
-/// sign of a zero is the scalar's too). Fewer points are padded with copies of point 0:
-/// a repeat of point 0 changes no bound, not even on a tie (the running bound is never
-/// beyond it). For finite lanes: where the running value is NaN, `f32::min` takes the
-/// point and this keeps the NaN.
+/// four points a group (`x[g][k]` is point 4g + k): the fold from point 0, `lo = p < lo ? p
+/// : lo` and `hi = p > hi ? p : hi` for the points after it in order, so a tie keeps the
+/// running value and with it the sign of a zero. That is bit for bit the scalar fold
+/// `lo.min(p)`, `hi.max(p)` as `f32::min` and `f32::max` compile on x86-64 (they keep their
+/// receiver on a tie; Rust leaves the choice open, and on aarch64 `fminnm` prefers −0).
+/// Fewer points are padded with copies of point 0: a repeat of point 0 changes no bound,
+/// not even on a tie (the running bound is never beyond it). With NaN lanes: where the
+/// running value is NaN, `f32::min` takes the point and this keeps the NaN (a transform of
+/// finite points by a normalised rotation gives none).
 #[inline(always)]
 pub(crate) fn bounds_of_points<const GROUPS: usize>(x: [F4; GROUPS], y: [F4; GROUPS]) -> ([f32; 2], [f32; 2]) {
     simd!(

@@ -1493,14 +1493,16 @@ mod tests {
 
     /// The group's flags are set from its lanes' columns: none without restitution or a
     /// rolling row in any lane (the fixture's lanes all have a rolling impulse), each one
-    /// by the one lane that has it, wherever that lane is; the heights are the first
-    /// points' along `up`, zero in empty lanes.
+    /// by the one lane that has it, wherever that lane is, and a rolling impulse not
+    /// without warm starting; the heights are the first points' along `up` (the second
+    /// point lies higher), zero in empty lanes.
     #[test]
     fn group_flags_and_heights_come_from_their_lanes() {
         let f = fixture();
         let (id, b) = (f.cases[0].0, &f.cases[0].2);
         let mut plain = f.cases[0].1;
         plain.rolling_impulse = 0.0;
+        plain.points[1].point.y = 0.7;
         let (mut rolling, mut bouncy, mut resisting) = (plain, plain, plain);
         rolling.rolling_impulse = 0.01;
         bouncy.restitution = 0.4;
@@ -1522,6 +1524,15 @@ mod tests {
             let heights: [f32; LANES] = core::array::from_fn(|l| if l == lane { height } else { 0.0 });
             assert_eq!(cold.height, heights);
         }
+        // Without warm starting the build drops the rolling impulse: no rolling row.
+        let cold_ctx = StepContext {
+            warm_starting: false,
+            ..f.ctx
+        };
+        let lanes: [LaneInput<'_>; LANES] = [None, Some((id, &rolling, b)), None, None];
+        let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
+        build_group(&mut h, &mut w, &mut cold, lanes, f.up, &cold_ctx, &f.states);
+        assert!(!h.any_rolling);
     }
 
     /// A group whose lanes all have one point takes the solve's one-point path, which skips
