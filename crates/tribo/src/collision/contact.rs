@@ -7,7 +7,7 @@
 use crate::dynamics::MixedMaterial;
 use crate::geometry::LINEAR_SLOP;
 use crate::geometry::{collide_bounded, Manifold, Shape, MAX_MANIFOLD_POINTS};
-use crate::math::wide::{split_xy, F4, M4};
+use crate::math::wide::{apply_lanes, split_xy, F4, M4};
 use crate::math::{Rot, Transform, Vec2};
 use crate::world::ShapeId;
 
@@ -295,15 +295,19 @@ impl Contact {
         // difference and its `length_squared`), in its order: the same bits. One pass of
         // four lanes instead of four transforms of two-vector scalar code (large_pyramid:
         // this function was 256 instructions a contact, nearly Box2D's full collision).
-        let flat = |v: &[Vec2; 2]| [v[0].x, v[0].y, v[1].x, v[1].y];
-        let (lb, la) = (flat(&basis.local_b), flat(&basis.local_a));
+        let points = |u: &[Vec2; 2], w: &[Vec2; 2]| split_xy([u[0], u[1], w[0], w[1]]);
+        let (lb, la) = (&basis.local_b, &basis.local_a);
         let pair = |u: f32, v: f32| F4::new([u, u, v, v]);
-        let moved = |(x, y): (F4, F4), (q, p): (Rot, Vec2), (q2, p2): (Rot, Vec2)| {
-            let (c, s) = (pair(q.c, q2.c), pair(q.s, q2.s));
-            (c * x - s * y + pair(p.x, p2.x), s * x + c * y + pair(p.y, p2.y))
+        // The first two lanes moved by (q, p), the last two by (q2, p2).
+        let moved = |xy: (F4, F4), (q, p): (Rot, Vec2), (q2, p2): (Rot, Vec2)| {
+            apply_lanes(
+                (pair(q.c, q2.c), pair(q.s, q2.s)),
+                (pair(p.x, p2.x), pair(p.y, p2.y)),
+                xy,
+            )
         };
-        let (mx, my) = moved(split_xy(lb, la), (rel.q, rel.p), (rel_ba.q, rel_ba.p));
-        let (bx, by) = split_xy(flat(&basis.b_in_a), flat(&basis.a_in_b));
+        let (mx, my) = moved(points(lb, la), (rel.q, rel.p), (rel_ba.q, rel_ba.p));
+        let (bx, by) = points(&basis.b_in_a, &basis.a_in_b);
         let (dx, dy) = (mx - bx, my - by);
         let real = if count >= 2 { ALL_LANES } else { FIRST_OF_EACH };
         if ((dx * dx + dy * dy).gt(F4::splat(limit2)) & real).any() {
@@ -312,7 +316,7 @@ impl Contact {
         let n = xf_a.q.rotate(basis.normal_a);
         self.manifold.normal = n;
         // The surface points in world axes, the same way: A's 0 and 1, B's 0 and 1.
-        let (wx, wy) = moved(split_xy(la, lb), (xf_a.q, xf_a.p), (xf_b.q, xf_b.p));
+        let (wx, wy) = moved(points(la, lb), (xf_a.q, xf_a.p), (xf_b.q, xf_b.p));
         for i in 0..count.min(MAX_MANIFOLD_POINTS) {
             let surface_a = Vec2::new(wx[i], wy[i]);
             let surface_b = Vec2::new(wx[2 + i], wy[2 + i]);

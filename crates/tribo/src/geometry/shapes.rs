@@ -1,7 +1,7 @@
 //! Shape types. All coordinates are in the body's local frame [m].
 
 use super::{GeometryError, LINEAR_SLOP};
-use crate::math::wide::{bounds_of_points, split_xy, F4};
+use crate::math::wide::{apply_lanes, bounds_of_points, split_xy, F4};
 use crate::math::{Aabb, Transform, Vec2};
 
 /// Most vertices a polygon may have (Box2D v3 uses 8).
@@ -393,18 +393,16 @@ impl Shape {
                 // code (large_pyramid), an eight-sided one about 300 (junkyard).
                 let (n, v) = (p.count(), &p.vertices);
                 let at = |i: usize| if i < n { v[i] } else { v[0] };
-                let (q, t) = (xf.q, xf.p);
-                let (c, s, tx, ty) = (F4::splat(q.c), F4::splat(q.s), F4::splat(t.x), F4::splat(t.y));
-                // `Transform::apply` lane by lane: (c x − s y) + p.x, (s x + c y) + p.y.
-                let group = |k: usize| {
-                    let [a, b, c2, d] = [at(k), at(k + 1), at(k + 2), at(k + 3)];
-                    let (x, y) = split_xy([a.x, a.y, b.x, b.y], [c2.x, c2.y, d.x, d.y]);
-                    (c * x - s * y + tx, s * x + c * y + ty)
-                };
+                let (rot, t) = (
+                    (F4::splat(xf.q.c), F4::splat(xf.q.s)),
+                    (F4::splat(xf.p.x), F4::splat(xf.p.y)),
+                );
+                // Vertices k … k + 3, padded, moved by `xf`.
+                let group = |k: usize| apply_lanes(rot, t, split_xy([at(k), at(k + 1), at(k + 2), at(k + 3)]));
                 let (lo, hi) = if n == 4 {
                     // Four vertices (every box): no slot to pad, so no `i < n` selects.
-                    let (x, y) = split_xy([v[0].x, v[0].y, v[1].x, v[1].y], [v[2].x, v[2].y, v[3].x, v[3].y]);
-                    bounds_of_points([c * x - s * y + tx], [s * x + c * y + ty])
+                    let (x, y) = apply_lanes(rot, t, split_xy([v[0], v[1], v[2], v[3]]));
+                    bounds_of_points([x], [y])
                 } else if n < 4 {
                     let (x, y) = group(0);
                     bounds_of_points([x], [y])

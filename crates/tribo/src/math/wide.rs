@@ -12,6 +12,7 @@
 //! the same reason). Masks are lanes of all-ones / all-zeros bits, like SIMD compare
 //! results.
 
+use super::Vec2;
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub, SubAssign};
 
 /// Lanes per wide constraint.
@@ -387,18 +388,27 @@ pub(crate) fn transpose(rows: [F4; LANES]) -> [F4; LANES] {
     )
 }
 
-/// Two pairs of 2D points, each pair four consecutive floats `[x0, y0, x1, y1]`, as the
-/// lanes `([p.x0, p.x1, q.x0, q.x1], [p.y0, p.y1, q.y0, q.y1])` (four shuffles).
+/// Four 2D points as lanes of x and of y: `([p0.x, p1.x, p2.x, p3.x], [p0.y, …])` (four
+/// shuffles of the points' coordinates).
 #[inline(always)]
-pub(crate) fn split_xy(p: [f32; LANES], q: [f32; LANES]) -> (F4, F4) {
+pub(crate) fn split_xy(p: [Vec2; LANES]) -> (F4, F4) {
+    let (a, b) = ([p[0].x, p[0].y, p[1].x, p[1].y], [p[2].x, p[2].y, p[3].x, p[3].y]);
     simd!(
         {
-            let (a, b) = (sse::f(F4::new(p)), sse::f(F4::new(q)));
+            let (a, b) = (sse::f(F4::new(a)), sse::f(F4::new(b)));
             let (t0, t1) = (_mm_unpacklo_ps(a, b), _mm_unpackhi_ps(a, b));
             (sse::to_f(_mm_unpacklo_ps(t0, t1)), sse::to_f(_mm_unpackhi_ps(t0, t1)))
         },
-        (F4::new([p[0], p[2], q[0], q[2]]), F4::new([p[1], p[3], q[1], q[3]]))
+        (F4::new([a[0], a[2], b[0], b[2]]), F4::new([a[1], a[3], b[1], b[3]]))
     )
+}
+
+/// `Transform::apply` lane by lane, its expression in its order, so every lane has the
+/// scalar bits: `(c x − s y) + t.x`, `(s x + c y) + t.y` for the points `(x, y)`, each lane
+/// with its own rotation `(c, s)` and translation `(t.x, t.y)`.
+#[inline(always)]
+pub(crate) fn apply_lanes((c, s): (F4, F4), (tx, ty): (F4, F4), (x, y): (F4, F4)) -> (F4, F4) {
+    (c * x - s * y + tx, s * x + c * y + ty)
 }
 
 /// The bounds `(min, max)`, as `[x, y]`, of `4 GROUPS` points given as lanes of x and of y,
@@ -678,10 +688,11 @@ impl Sub for V4 {
 mod tests {
     use super::*;
 
-    /// `split_xy` gathers the x and the y of two interleaved pairs of points.
+    /// `split_xy` gathers the x and the y of four points, in order.
     #[test]
-    fn split_xy_gathers_the_coordinates_of_two_pairs() {
-        let (x, y) = split_xy([1.0, 2.0, 3.0, 4.0], [5.0, 6.0, 7.0, 8.0]);
+    fn split_xy_gathers_the_coordinates_of_four_points() {
+        let v = Vec2::new;
+        let (x, y) = split_xy([v(1.0, 2.0), v(3.0, 4.0), v(5.0, 6.0), v(7.0, 8.0)]);
         assert_eq!(*x, [1.0, 3.0, 5.0, 7.0]);
         assert_eq!(*y, [2.0, 4.0, 6.0, 8.0]);
     }

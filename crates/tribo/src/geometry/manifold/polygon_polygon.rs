@@ -158,8 +158,7 @@ fn max_separation(p1: &LocalPoly, p2: &LocalPoly) -> (usize, f32) {
 /// reducing each edge alone).
 #[inline(always)]
 fn max_separation_4x4(p1: &LocalPoly, p2: &LocalPoly) -> (usize, f32) {
-    let flat = |a: Vec2, b: Vec2| [a.x, a.y, b.x, b.y];
-    let (xs, ys) = split_xy(flat(p2.v[0], p2.v[1]), flat(p2.v[2], p2.v[3]));
+    let (xs, ys) = split_xy([p2.v[0], p2.v[1], p2.v[2], p2.v[3]]);
     let rows: [F4; 4] = core::array::from_fn(|i| {
         let (n, v) = (p1.n[i], p1.v[i]);
         // n · (p2.v[j] − v), the same expression as `Vec2::dot`.
