@@ -164,14 +164,10 @@ impl WideHead {
 /// The rest of four contact constraints, one per lane (see the module docs): what only
 /// the solve passes read.
 ///
-/// The passes are bound by arithmetic, not by streaming these records: run twice over
-/// each colour (the second time from cache), large_pyramid's relax pass took exactly twice
-/// as long. So what every pass would derive again is made once a step ([`Self::derive`]):
-/// the friction row's anchors and K⁻¹ (large_pyramid: 2.4 % fewer instructions, solver
-/// stages 2.5-3.5 % faster over ten interleaved runs). Still derived where they are used:
-/// the softness (from whether a side is static), 1/k11 and 1/k22 (the points' normal
-/// masses where the block applies) and the rolling mass (from the inverse inertias).
-/// 512 bytes.
+/// What costs a few instructions to derive is not stored (less for every pass to stream): the softness (from whether a side is static), K⁻¹ (from K and 1/det K),
+/// 1/k11 and 1/k22 (the points' normal masses where the block applies), the friction row's
+/// anchors (from the points' anchors) and the rolling mass (from the inverse inertias).
+/// 400 bytes (was 608).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WideContact {
     /// Friction coefficient of the row this step: μs where it sticks, μd where it slides.
@@ -190,29 +186,6 @@ pub(crate) struct WideContact {
     pub stick: M4,
     pub total_tangent_impulse: F4,
     pub saturated: M4,
-    /// The friction row's anchors [m] ([`friction_arms`] of the group, made once a step).
-    pub fr_a: V4,
-    pub fr_b: V4,
-    /// K⁻¹ = [k22, −k12; −k12, k11] / det K (zero where the block does not apply), made
-    /// once a step from the stored K and 1/det K (`k22 · inv_det`, …).
-    pub i11: F4,
-    pub i12: F4,
-    pub i22: F4,
-}
-
-impl WideContact {
-    /// Sets what the passes read ready-made and derive from the rest: the friction
-    /// anchors from `h`'s points and K⁻¹ from K and 1/det K (the expressions the passes
-    /// evaluated each time, so the same bits).
-    #[inline(always)]
-    fn derive(&mut self, h: &WideHead) {
-        (self.fr_a, self.fr_b) = friction_arms(h);
-        (self.i11, self.i12, self.i22) = (
-            self.k22 * self.inv_det,
-            -self.k12 * self.inv_det,
-            self.k11 * self.inv_det,
-        );
-    }
 }
 
 /// The parts of four constraints the substeps do not touch (kept apart so the hot
@@ -236,7 +209,7 @@ pub(crate) struct WideCold {
 }
 
 // What the hot passes stream per group of four constraints (bytes).
-const _: () = assert!(core::mem::size_of::<WideContact>() == 512);
+const _: () = assert!(core::mem::size_of::<WideContact>() == 400);
 const _: () = assert!(core::mem::size_of::<WideHead>() == 416);
 
 /// Four bodies' velocities and step motion, gathered from [`BodyState`]s.
@@ -467,7 +440,7 @@ pub(crate) fn restitution<S: StateCell>(h: &mut WideHead, w: &mut WideContact, c
         let rhs0 = normal_velocity(&a, &b, 0) + e * w.points[0].approach;
         let rhs1 = normal_velocity(&a, &b, 1) + e * w.points[1].approach;
         let (k11, k12, k22) = (w.k11, w.k12, w.k22);
-        let (i11, i12, i22) = (w.i11, w.i12, w.i22);
+        let (i11, i12, i22) = (k22 * w.inv_det, -k12 * w.inv_det, k11 * w.inv_det);
         let (one, none) = (F4::splat(1.0), F4::ZERO);
         let soft0 = |rd: F4| lam0 + one * rd - none * (lam0 - pre0);
         let soft1 = |rd: F4| lam1 + one * rd - none * (lam1 - pre1);
@@ -606,8 +579,8 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
         let rhs1 = vn[1] + bias[1];
         let soft0 = |rd: F4| lam0 + ms[0] * rd - is[0] * (lam0 - pre0);
         let soft1 = |rd: F4| lam1 + ms[1] * rd - is[1] * (lam1 - pre1);
-        // K⁻¹ (zero where the block does not apply).
-        let (i11, i12, i22) = (c.i11, c.i12, c.i22);
+        // K⁻¹ = [k22, −k12; −k12, k11] / det K (zero where the block does not apply).
+        let (i11, i12, i22) = (c.k22 * c.inv_det, -c.k12 * c.inv_det, c.k11 * c.inv_det);
         let xa0 = soft0(-(i11 * rhs0 + i12 * rhs1));
         let xa1 = soft1(-(i12 * rhs0 + i22 * rhs1));
         let ok_a = xa0.ge(zero) & xa1.ge(zero);
@@ -709,7 +682,7 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
 
     // Friction row (contact_solver::solve_friction).
     let t = V4 { x: n.y, y: -n.x };
-    let (fr_a, fr_b) = (c.fr_a, c.fr_b);
+    let (fr_a, fr_b) = friction_arms(h);
     let (r_a, r_b) = lever_arms(h, shift, fr_a, fr_b);
     let limit = c.mu * (new0 + new1);
     let vt = relative_velocity(&a, &b, r_a, r_b).dot(t) - c.tangent_speed;
@@ -946,7 +919,6 @@ pub(crate) fn build_group<S: StateRead>(
     out.k12 = block.select(k12, zero);
     out.k22 = block.select(k22, zero);
     out.inv_det = block.select(inv, zero);
-    out.derive(hd);
 }
 
 /// `contact_solver::shift_cap2` four lanes at once (the same quotients and minimum; the
@@ -1237,7 +1209,6 @@ pub(crate) fn pack(
     w.stick[l] = if stick { u32::MAX } else { 0 };
     w.mu[l] = if stick { cc.mu_s } else { cc.mu_d };
     h.two_points[l] = if cc.count == 2 { u32::MAX } else { 0 };
-    w.derive(h);
     pack_state(h, w, l, cc);
 }
 
@@ -1482,14 +1453,7 @@ mod tests {
         let (ctx, soft, states, up, cases) = (f.ctx, f.soft, &f.states, f.up, &f.cases);
         let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
         build_group(&mut h, &mut w, &mut cold, f.lanes(), up, &ctx, states);
-        // Packed lane by lane over a copy of the built group whose ready-made parts (the
-        // friction anchors and K⁻¹) are spoilt first: pack must make them again.
         let (mut rh, mut r, mut rcold) = (h, w, cold);
-        let spoilt = V4 {
-            x: F4::splat(7.0),
-            y: F4::splat(7.0),
-        };
-        (r.fr_a, r.fr_b, r.i11, r.i12, r.i22) = (spoilt, spoilt, spoilt.x, spoilt.x, spoilt.x);
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
             let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
             let dyn_side = |m: f32, i: f32| m > 0.0 || i > 0.0;
