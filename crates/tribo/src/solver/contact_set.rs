@@ -37,10 +37,10 @@ use super::contact_solver::{
     store_impulses, warm_start_one, ConstraintBodies, ContactConstraint, ContactInput, StepSoftness, MASS_RATIO_GROUP,
     MAX_ESTIMATE_SWEEPS, MAX_LOCAL_SWEEPS, ONGOING_ESTIMATE_SWEEPS,
 };
-use super::contact_wide::{self, StoredContact, WideCold, WideContact, WideHead, COLORS, DYNAMIC_COLORS};
+use super::contact_wide::{self, StoredContact, WideCold, WideContact, WideDerived, WideHead, COLORS, DYNAMIC_COLORS};
 use super::wide::LANES;
 use super::{
-    any_load, claim_each, for_each_chunk_mut3, integrate_positions_range, integrate_velocity_one, BodySim,
+    any_load, claim_each, for_each_chunk_mut4, integrate_positions_range, integrate_velocity_one, BodySim,
     ConstraintSet, SharedState, SolverBody, StateCell, StateRead, StepContext, TeamProgress,
 };
 use crate::collision::contact::{Contact, NO_COLOUR};
@@ -238,6 +238,8 @@ pub(crate) struct ContactSolver {
     head: Vec<WideHead>,
     wide: Vec<WideContact>,
     cold: Vec<WideCold>,
+    /// Per group: what the passes read ready-made ([`contact_wide::derive`]).
+    derived: Vec<WideDerived>,
     /// Constraints that found no colour, whole (solved first in each pass).
     overflow: Vec<ContactConstraint>,
     /// Constraints whose points are all new this step and touching (those the warm-start
@@ -336,7 +338,7 @@ type TeamCuts = Vec<Vec<Vec<usize>>>;
 
 /// A colour's block: its groups (the mutex only hands the claiming thread its `&mut`; it
 /// is never contended).
-type GroupBlock<'a> = TeamBlock<std::sync::Mutex<(&'a mut [WideHead], &'a mut [WideContact])>>;
+type GroupBlock<'a> = TeamBlock<std::sync::Mutex<(&'a mut [WideHead], &'a mut [WideContact], &'a [WideDerived])>>;
 
 /// One part of a pass for the substep team: its blocks, thread `k`'s own ones being
 /// `blocks[shares[k] .. shares[k + 1]]` (see `ContactSolver::team_blocks`).
@@ -526,13 +528,11 @@ impl ContactSolver {
         // 4. Build and pack the coloured constraints, four lanes per task.
         let up = self.up;
         let lane_candidates = &self.lane_candidates;
-        for_each_chunk_mut3(
+        for_each_chunk_mut4(
             ctx.parallel,
-            &mut self.head,
-            &mut self.wide,
-            &mut self.cold,
+            (&mut self.head, &mut self.wide, &mut self.cold, &mut self.derived),
             GROUP_CHUNK,
-            |first, heads, wides, colds| {
+            |first, heads, wides, colds, derived| {
                 for k in 0..heads.len() {
                     let g = first + k;
                     if let Some(ahead) = lane_candidates.get(g + PREFETCH_GROUPS) {
@@ -558,8 +558,11 @@ impl ContactSolver {
                             .get(i as usize)
                             .map(|cand| (cand.contact, &cand.input, &cand.bodies))
                     });
-                    if let (Some(h), Some(w), Some(cold)) = (heads.get_mut(k), wides.get_mut(k), colds.get_mut(k)) {
+                    if let (Some(h), Some(w), Some(cold), Some(dv)) =
+                        (heads.get_mut(k), wides.get_mut(k), colds.get_mut(k), derived.get_mut(k))
+                    {
                         contact_wide::build_group(h, w, cold, lanes, up, ctx, states);
+                        *dv = contact_wide::derive(h, w);
                     }
                 }
             },
@@ -680,6 +683,8 @@ impl ContactSolver {
         self.cold.resize(groups as usize, WideCold::default());
         self.wide.truncate(groups as usize);
         self.cold.truncate(groups as usize);
+        self.derived.resize(groups as usize, WideDerived::default());
+        self.derived.truncate(groups as usize);
         // 3. Slots: overflow constraints are built here, coloured ones below.
         let soft = self.soft;
         self.slots.clear();
@@ -922,6 +927,9 @@ impl ContactSolver {
                 if full {
                     let (da, db) = (h.write_a[lane as usize], h.write_b[lane as usize]);
                     contact_wide::pack(h, w, &mut self.cold[g], lane as usize, cc, da, db);
+                    // The lane's geometry came back as it was unpacked, so this changes
+                    // nothing today; made again so a pack that did change it stays right.
+                    self.derived[g] = contact_wide::derive(h, w);
                 } else {
                     contact_wide::pack_state(h, w, lane as usize, cc);
                 }
@@ -1117,17 +1125,22 @@ impl ConstraintSet for ContactSolver {
         let soft = &self.soft;
         // Colour after colour; the groups of one colour share no moving body.
         for &(start, end) in &self.ranges {
-            let (heads, colour) = (
+            let (heads, colour, derived) = (
                 &mut self.head[start as usize..end as usize],
                 &mut self.wide[start as usize..end as usize],
+                &self.derived[start as usize..end as usize],
             );
             if use_bias {
-                S::for_each_mut2(states, heads, colour, GROUP_CHUNK, |_, h, w, states| {
-                    contact_wide::solve::<true, S>(h, w, states, ctx, soft, elapsed)
+                S::for_each_mut2(states, heads, colour, GROUP_CHUNK, |i, h, w, states| {
+                    if let Some(dv) = derived.get(i) {
+                        contact_wide::solve::<true, S>(h, w, dv, states, ctx, soft, elapsed)
+                    }
                 });
             } else {
-                S::for_each_mut2(states, heads, colour, GROUP_CHUNK, |_, h, w, states| {
-                    contact_wide::solve::<false, S>(h, w, states, ctx, soft, elapsed)
+                S::for_each_mut2(states, heads, colour, GROUP_CHUNK, |i, h, w, states| {
+                    if let Some(dv) = derived.get(i) {
+                        contact_wide::solve::<false, S>(h, w, dv, states, ctx, soft, elapsed)
+                    }
                 });
             }
         }
@@ -1219,13 +1232,13 @@ impl ContactSolver {
             let mut lap = Stopwatch::start();
             let mut t = [0.0f32; 5];
             let mut at = TeamCursor::default();
-            let each_colour = |at: &mut TeamCursor, f: &dyn Fn(&mut WideHead, &mut WideContact)| {
+            let each_colour = |at: &mut TeamCursor, f: &dyn Fn(&mut WideHead, &mut WideContact, &WideDerived)| {
                 for parts in &colours {
                     team_pass(parts, k, at, &progress, |part| {
                         let mut guard = part.lock().unwrap_or_else(|e| e.into_inner());
-                        let (heads, wides) = &mut *guard;
-                        for (h, w) in heads.iter_mut().zip(wides.iter_mut()) {
-                            f(h, w);
+                        let (heads, wides, derived) = &mut *guard;
+                        for ((h, w), dv) in heads.iter_mut().zip(wides.iter_mut()).zip(derived.iter()) {
+                            f(h, w, dv);
                         }
                     });
                 }
@@ -1238,18 +1251,18 @@ impl ContactSolver {
                     }
                 });
                 t[0] += lap.lap();
-                each_colour(&mut at, &|h, _| contact_wide::warm_start(h, states));
+                each_colour(&mut at, &|h, _, _| contact_wide::warm_start(h, states));
                 t[1] += lap.lap();
-                each_colour(&mut at, &|h, w| {
-                    contact_wide::solve::<true, SharedState>(h, w, states, ctx, &soft, elapsed)
+                each_colour(&mut at, &|h, w, dv| {
+                    contact_wide::solve::<true, SharedState>(h, w, dv, states, ctx, &soft, elapsed)
                 });
                 t[2] += lap.lap();
                 team_pass(&bodies, k, &mut at, &progress, |range| {
                     integrate_positions_range(ctx, sims, states, range.clone());
                 });
                 t[3] += lap.lap();
-                each_colour(&mut at, &|h, w| {
-                    contact_wide::solve::<false, SharedState>(h, w, states, ctx, &soft, elapsed + ctx.h)
+                each_colour(&mut at, &|h, w, dv| {
+                    contact_wide::solve::<false, SharedState>(h, w, dv, states, ctx, &soft, elapsed + ctx.h)
                 });
                 t[4] += lap.lap();
             }
@@ -1325,6 +1338,7 @@ impl ContactSolver {
             _ => self.team_cuts(threads, per_thread),
         };
         let (mut heads, mut wides): (&mut [WideHead], &mut [WideContact]) = (&mut self.head, &mut self.wide);
+        let mut derived: &[WideDerived] = &self.derived;
         let mut taken = 0usize;
         let mut colours = Vec::with_capacity(cuts.len());
         for parts in &cuts {
@@ -1332,7 +1346,8 @@ impl ContactSolver {
             for at in parts {
                 let (_, h_rest) = core::mem::take(&mut heads).split_at_mut(at[0] - taken);
                 let (_, w_rest) = core::mem::take(&mut wides).split_at_mut(at[0] - taken);
-                (heads, wides, taken) = (h_rest, w_rest, at[0]);
+                let (_, d_rest) = derived.split_at(at[0] - taken);
+                (heads, wides, derived, taken) = (h_rest, w_rest, d_rest, at[0]);
                 let mut part = TeamPart {
                     blocks: Vec::new(),
                     shares: Vec::with_capacity(threads + 1),
@@ -1342,9 +1357,14 @@ impl ContactSolver {
                     let len = at[k + 1] - at[k];
                     let (h, h_rest) = core::mem::take(&mut heads).split_at_mut(len);
                     let (w, w_rest) = core::mem::take(&mut wides).split_at_mut(len);
-                    (heads, wides, taken) = (h_rest, w_rest, at[k + 1]);
-                    for part_of in h.chunks_mut(TEAM_BLOCK).zip(w.chunks_mut(TEAM_BLOCK)) {
-                        part.blocks.push(TeamBlock::new(std::sync::Mutex::new(part_of)));
+                    let (d, d_rest) = derived.split_at(len);
+                    (heads, wides, derived, taken) = (h_rest, w_rest, d_rest, at[k + 1]);
+                    let blocks = h
+                        .chunks_mut(TEAM_BLOCK)
+                        .zip(w.chunks_mut(TEAM_BLOCK))
+                        .zip(d.chunks(TEAM_BLOCK));
+                    for ((hs, ws), ds) in blocks {
+                        part.blocks.push(TeamBlock::new(std::sync::Mutex::new((hs, ws, ds))));
                     }
                 }
                 part.shares.push(part.blocks.len());

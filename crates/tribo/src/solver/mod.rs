@@ -723,27 +723,9 @@ pub(crate) fn for_each_mut2<A: Send, B: Send>(
     });
 }
 
-/// [`for_each_mut`] over three slices by chunks of `min_len`: `f(first, a, b, c)` gets a
+/// [`for_each_mut`] over four slices by chunks of `min_len`: `f(first, a, b, c, d)` gets a
 /// chunk of each slice (its first element at index `first`), so it can look ahead inside
 /// the chunk. One chunk on one thread.
-pub(crate) fn for_each_chunk_mut3<A: Send, B: Send, C: Send>(
-    parallel: bool,
-    a: &mut [A],
-    b: &mut [B],
-    c: &mut [C],
-    min_len: usize,
-    f: impl Fn(usize, &mut [A], &mut [B], &mut [C]) + Sync,
-) {
-    if parallel {
-        let n = min_len.max(1);
-        let chunks = a.chunks_mut(n).zip(b.chunks_mut(n)).zip(c.chunks_mut(n)).enumerate();
-        claim_each(true, chunks, |(k, ((x, y), z))| f(k * n, x, y, z));
-    } else {
-        f(0, a, b, c);
-    }
-}
-
-/// [`for_each_chunk_mut3`] over four slices.
 pub(crate) fn for_each_chunk_mut4<A: Send, B: Send, C: Send, D: Send>(
     parallel: bool,
     slices: (&mut [A], &mut [B], &mut [C], &mut [D]),
@@ -1031,7 +1013,7 @@ pub(crate) fn integrate_position_one<S: StateCell>(ctx: &StepContext, sim: &Body
 
 #[cfg(test)]
 mod claim_tests {
-    use super::{claim_each, for_each_chunk_mut3};
+    use super::{claim_each, for_each_chunk_mut4};
     use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
     /// Every item runs exactly once, on two threads as on one, for counts below, at and
@@ -1057,18 +1039,20 @@ mod claim_tests {
     #[test]
     fn chunks_know_their_first_index() {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("pool");
-        let (mut a, mut b, mut c) = (vec![0usize; 1001], vec![0u8; 1001], vec![0u8; 1001]);
+        let (mut a, mut b, mut c, mut d) = (vec![0usize; 1001], vec![0u8; 1001], vec![0u8; 1001], vec![0u8; 1001]);
         pool.install(|| {
-            for_each_chunk_mut3(true, &mut a, &mut b, &mut c, 32, |first, xs, ys, zs| {
-                for (k, ((x, y), z)) in xs.iter_mut().zip(ys.iter_mut()).zip(zs.iter_mut()).enumerate() {
-                    *x = first + k;
+            for_each_chunk_mut4(true, (&mut a, &mut b, &mut c, &mut d), 32, |first, ws, xs, ys, zs| {
+                let rows = ws.iter_mut().zip(xs.iter_mut()).zip(ys.iter_mut()).zip(zs.iter_mut());
+                for (k, (((w, x), y), z)) in rows.enumerate() {
+                    *w = first + k;
+                    *x += 1;
                     *y += 1;
                     *z += 1;
                 }
             })
         });
         assert!(a.iter().enumerate().all(|(i, &x)| x == i));
-        assert!(b.iter().chain(&c).all(|&y| y == 1));
+        assert!(b.iter().chain(&c).chain(&d).all(|&y| y == 1));
     }
 
     /// Inside a step, every stage leaves a spinner on the pool's other thread
