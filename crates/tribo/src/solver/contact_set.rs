@@ -561,8 +561,7 @@ impl ContactSolver {
                     if let (Some(h), Some(w), Some(cold), Some(dv)) =
                         (heads.get_mut(k), wides.get_mut(k), colds.get_mut(k), derived.get_mut(k))
                     {
-                        contact_wide::build_group(h, w, cold, lanes, up, ctx, states);
-                        *dv = contact_wide::derive(h, w);
+                        contact_wide::build_group(h, w, cold, dv, lanes, up, ctx, states);
                     }
                 }
             },

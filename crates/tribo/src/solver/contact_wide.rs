@@ -769,6 +769,7 @@ pub(crate) fn build_group<S: StateRead>(
     head: &mut WideHead,
     w: &mut WideContact,
     cold: &mut WideCold,
+    derived: &mut WideDerived,
     lanes: [LaneInput<'_>; LANES],
     up: Vec2,
     ctx: &StepContext,
@@ -954,6 +955,7 @@ pub(crate) fn build_group<S: StateRead>(
     out.k12 = block.select(k12, zero);
     out.k22 = block.select(k22, zero);
     out.inv_det = block.select(inv, zero);
+    *derived = derive(hd, out);
 }
 
 /// `contact_solver::shift_cap2` four lanes at once (the same quotients and minimum; the
@@ -1487,7 +1489,10 @@ mod tests {
         let f = fixture();
         let (ctx, soft, states, up, cases) = (f.ctx, f.soft, &f.states, f.up, &f.cases);
         let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
-        build_group(&mut h, &mut w, &mut cold, f.lanes(), up, &ctx, states);
+        let mut dv = WideDerived::default();
+        build_group(&mut h, &mut w, &mut cold, &mut dv, f.lanes(), up, &ctx, states);
+        // The ready-made part is what the group derives (what a pack makes again).
+        assert_eq!(format!("{dv:?}"), format!("{:?}", derive(&h, &w)));
         let (mut rh, mut r, mut rcold) = (h, w, cold);
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
             let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
@@ -1552,7 +1557,16 @@ mod tests {
             let mut lanes: [LaneInput<'_>; LANES] = [None; LANES];
             lanes[lane] = Some((id, input, b));
             let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
-            build_group(&mut h, &mut w, &mut cold, lanes, f.up, &f.ctx, &f.states);
+            build_group(
+                &mut h,
+                &mut w,
+                &mut cold,
+                &mut WideDerived::default(),
+                lanes,
+                f.up,
+                &f.ctx,
+                &f.states,
+            );
             assert_eq!((h.any_restitution, h.any_rolling), expected, "lane {lane}");
             assert_eq!(cold.any_restitution, expected.0);
             let height = input.points[0].point.dot(f.up);
@@ -1566,7 +1580,16 @@ mod tests {
         };
         let lanes: [LaneInput<'_>; LANES] = [None, Some((id, &rolling, b)), None, None];
         let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
-        build_group(&mut h, &mut w, &mut cold, lanes, f.up, &cold_ctx, &f.states);
+        build_group(
+            &mut h,
+            &mut w,
+            &mut cold,
+            &mut WideDerived::default(),
+            lanes,
+            f.up,
+            &cold_ctx,
+            &f.states,
+        );
         assert!(!h.any_rolling);
     }
 
@@ -1598,9 +1621,18 @@ mod tests {
         ];
         let lanes: [LaneInput<'_>; LANES] = core::array::from_fn(|l| cases.get(l).map(|c| (c.0, &c.1, &c.2)));
         let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
-        build_group(&mut h, &mut w, &mut cold, lanes, Vec2::new(0.0, 1.0), &ctx, &states);
+        let mut dv = WideDerived::default();
+        build_group(
+            &mut h,
+            &mut w,
+            &mut cold,
+            &mut dv,
+            lanes,
+            Vec2::new(0.0, 1.0),
+            &ctx,
+            &states,
+        );
         let built = (h, w);
-        let dv = derive(&h, &w);
         let mut scalar: Vec<ContactConstraint> = (0..3).map(|l| unpack_full(&h, &w, &cold, &soft, l)).collect();
         let cells = |s: &[BodyState]| -> Vec<core::cell::Cell<BodyState>> {
             s.iter().map(|&s| core::cell::Cell::new(s)).collect()
@@ -1690,9 +1722,9 @@ mod tests {
     fn wide_store_equals_scalar_store() {
         let f = fixture();
         let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
-        build_group(&mut h, &mut w, &mut cold, f.lanes(), f.up, &f.ctx, &f.states);
+        let mut dv = WideDerived::default();
+        build_group(&mut h, &mut w, &mut cold, &mut dv, f.lanes(), f.up, &f.ctx, &f.states);
         let cells: Vec<core::cell::Cell<BodyState>> = f.states.iter().map(|&s| core::cell::Cell::new(s)).collect();
-        let dv = derive(&h, &w);
         solve::<false, _>(&mut h, &mut w, &dv, &cells, &f.ctx, &f.soft, f.ctx.h);
         let moved: Vec<BodyState> = cells
             .iter()
@@ -1758,7 +1790,16 @@ mod tests {
             None,
         ];
         let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
-        build_group(&mut h, &mut w, &mut cold, lanes, Vec2::new(0.0, 1.0), &ctx, &states);
+        build_group(
+            &mut h,
+            &mut w,
+            &mut cold,
+            &mut WideDerived::default(),
+            lanes,
+            Vec2::new(0.0, 1.0),
+            &ctx,
+            &states,
+        );
         // Impact speeds and loads as the substeps would leave them: every point bounces but
         // lane 2's second (slower than the 1 m/s threshold); lane 1 had little energy.
         for (i, approach) in [[-3.0, -2.0, -2.5, 0.0], [-2.5, 0.0, -0.5, 0.0]]
