@@ -1374,6 +1374,18 @@ mod tests {
     use crate::solver::contact_solver::{build_constraint, restitution_one, store_impulses, InputPoint};
     use crate::solver::BodyState;
 
+    /// A group built from `lanes` (the build's four outputs).
+    fn built<S: StateRead>(
+        lanes: [LaneInput<'_>; LANES],
+        up: Vec2,
+        ctx: &StepContext,
+        states: &[S],
+    ) -> (WideHead, WideContact, WideCold, WideDerived) {
+        let (mut h, mut w, mut cold, mut dv) = Default::default();
+        build_group(&mut h, &mut w, &mut cold, &mut dv, lanes, up, ctx, states);
+        (h, w, cold, dv)
+    }
+
     fn input(count: usize, fresh: bool, restitution: f32, rolling: f32) -> ContactInput {
         let point = |x: f32, sep: f32| InputPoint {
             point: Vec2::new(x, 0.3),
@@ -1488,9 +1500,7 @@ mod tests {
     fn wide_build_equals_scalar_build_and_pack() {
         let f = fixture();
         let (ctx, soft, states, up, cases) = (f.ctx, f.soft, &f.states, f.up, &f.cases);
-        let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
-        let mut dv = WideDerived::default();
-        build_group(&mut h, &mut w, &mut cold, &mut dv, f.lanes(), up, &ctx, states);
+        let (h, w, cold, dv) = built(f.lanes(), up, &ctx, states);
         // The ready-made part is what the group derives (what a pack makes again).
         assert_eq!(format!("{dv:?}"), format!("{:?}", derive(&h, &w)));
         let (mut rh, mut r, mut rcold) = (h, w, cold);
@@ -1556,17 +1566,7 @@ mod tests {
         ] {
             let mut lanes: [LaneInput<'_>; LANES] = [None; LANES];
             lanes[lane] = Some((id, input, b));
-            let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
-            build_group(
-                &mut h,
-                &mut w,
-                &mut cold,
-                &mut WideDerived::default(),
-                lanes,
-                f.up,
-                &f.ctx,
-                &f.states,
-            );
+            let (h, _, cold, _) = built(lanes, f.up, &f.ctx, &f.states);
             assert_eq!((h.any_restitution, h.any_rolling), expected, "lane {lane}");
             assert_eq!(cold.any_restitution, expected.0);
             let height = input.points[0].point.dot(f.up);
@@ -1579,17 +1579,7 @@ mod tests {
             ..f.ctx
         };
         let lanes: [LaneInput<'_>; LANES] = [None, Some((id, &rolling, b)), None, None];
-        let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
-        build_group(
-            &mut h,
-            &mut w,
-            &mut cold,
-            &mut WideDerived::default(),
-            lanes,
-            f.up,
-            &cold_ctx,
-            &f.states,
-        );
+        let (h, ..) = built(lanes, f.up, &cold_ctx, &f.states);
         assert!(!h.any_rolling);
     }
 
@@ -1620,18 +1610,7 @@ mod tests {
             (8, input(points, false, 0.0, 0.05), bodies(4, 5)),
         ];
         let lanes: [LaneInput<'_>; LANES] = core::array::from_fn(|l| cases.get(l).map(|c| (c.0, &c.1, &c.2)));
-        let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
-        let mut dv = WideDerived::default();
-        build_group(
-            &mut h,
-            &mut w,
-            &mut cold,
-            &mut dv,
-            lanes,
-            Vec2::new(0.0, 1.0),
-            &ctx,
-            &states,
-        );
+        let (mut h, mut w, cold, dv) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
         let built = (h, w);
         let mut scalar: Vec<ContactConstraint> = (0..3).map(|l| unpack_full(&h, &w, &cold, &soft, l)).collect();
         let cells = |s: &[BodyState]| -> Vec<core::cell::Cell<BodyState>> {
@@ -1721,9 +1700,7 @@ mod tests {
     #[test]
     fn wide_store_equals_scalar_store() {
         let f = fixture();
-        let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
-        let mut dv = WideDerived::default();
-        build_group(&mut h, &mut w, &mut cold, &mut dv, f.lanes(), f.up, &f.ctx, &f.states);
+        let (mut h, mut w, cold, dv) = built(f.lanes(), f.up, &f.ctx, &f.states);
         let cells: Vec<core::cell::Cell<BodyState>> = f.states.iter().map(|&s| core::cell::Cell::new(s)).collect();
         solve::<false, _>(&mut h, &mut w, &dv, &cells, &f.ctx, &f.soft, f.ctx.h);
         let moved: Vec<BodyState> = cells
@@ -1789,17 +1766,7 @@ mod tests {
             Some((cases[2].0, &cases[2].1, &cases[2].2)),
             None,
         ];
-        let (mut h, mut w, mut cold) = (WideHead::default(), WideContact::default(), WideCold::default());
-        build_group(
-            &mut h,
-            &mut w,
-            &mut cold,
-            &mut WideDerived::default(),
-            lanes,
-            Vec2::new(0.0, 1.0),
-            &ctx,
-            &states,
-        );
+        let (mut h, mut w, mut cold, _) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
         // Impact speeds and loads as the substeps would leave them: every point bounces but
         // lane 2's second (slower than the 1 m/s threshold); lane 1 had little energy.
         for (i, approach) in [[-3.0, -2.0, -2.5, 0.0], [-2.5, 0.0, -0.5, 0.0]]
