@@ -544,14 +544,16 @@ impl ContactSolver {
                     }
                     // The group's output lines too: read for ownership now, they are written
                     // without waiting (a line only this core holds is then written in place).
-                    if let (Some(h), Some(w), Some(c)) = (
+                    if let (Some(h), Some(w), Some(c), Some(d)) = (
                         heads.get(k + PREFETCH_GROUPS),
                         wides.get(k + PREFETCH_GROUPS),
                         colds.get(k + PREFETCH_GROUPS),
+                        derived.get(k + PREFETCH_GROUPS),
                     ) {
                         super::prefetch(h);
                         super::prefetch(w);
                         super::prefetch(c);
+                        super::prefetch(d);
                     }
                     let lanes = lane_candidates[g].map(|i| {
                         candidates
@@ -860,6 +862,8 @@ impl ContactSolver {
     /// states rely on it, see [`SharedState`]).
     #[cfg(debug_assertions)]
     fn check_colours(&self, bodies: usize) {
+        // The passes find a group's ready-made part by its index.
+        debug_assert_eq!(self.derived.len(), self.head.len());
         let mut seen = vec![u32::MAX; bodies];
         for (k, &(start, end)) in self.ranges.iter().enumerate() {
             for h in &self.head[start as usize..end as usize] {
@@ -925,10 +929,9 @@ impl ContactSolver {
                 let (h, w) = (&mut self.head[g], &mut self.wide[g]);
                 if full {
                     let (da, db) = (h.write_a[lane as usize], h.write_b[lane as usize]);
-                    contact_wide::pack(h, w, &mut self.cold[g], lane as usize, cc, da, db);
-                    // The lane's geometry came back as it was unpacked, so this changes
-                    // nothing today; made again so a pack that did change it stays right.
-                    self.derived[g] = contact_wide::derive(h, w);
+                    // (The lane's geometry comes back as it was unpacked, so the group's
+                    // derived part is made again with the same bits.)
+                    contact_wide::pack(h, w, &mut self.cold[g], &mut self.derived[g], lane as usize, cc, da, db);
                 } else {
                     contact_wide::pack_state(h, w, lane as usize, cc);
                 }

@@ -11,7 +11,7 @@
 //!   colour, so each pass solves them last (the ground has the last word, as in Box2D).
 //!   A constraint that finds no colour goes to the overflow list, solved by the scalar code
 //!   before the coloured work of each pass.
-//! * **Wide layout**: four constraints as structure-of-arrays ([`F4`] lanes), in three
+//! * **Wide layout**: four constraints as structure-of-arrays ([`F4`] lanes), in four
 //!   arrays by use: [`WideHead`] (bodies, normal, masses, anchors, impulses: all the warm
 //!   start reads, so it streams ~400 bytes per group, not 1 KiB), [`WideContact`] (the
 //!   rest the solve passes read), [`WideDerived`] (what the solve passes would derive again
@@ -25,7 +25,11 @@
 //!   dynamic bodies are written (no two lanes of a colour share one).
 //!
 //! A lane computes the same expressions as the scalar code in the same order of
-//! operations, so a contact solved wide or scalar gets the same numbers.
+//! operations, so a contact solved wide or scalar gets the same numbers: to the bit for
+//! the build, the store, restitution and one-point rows; the scalar 2×2 block rounds its
+//! own way (an ulp or a few tens of ulps after a pass), so a two-point lane solved wide
+//! agrees with the scalar solve to 1e-4 (`two_point_solve_matches_scalar_solve`). A
+//! contact is solved one way for a whole step.
 
 use super::contact_solver::{
     fresh_point_sticks, kinetic_energy_of, ConstraintBodies, ConstraintPoint, ContactConstraint, ContactInput,
@@ -242,6 +246,7 @@ pub(crate) fn derive(h: &WideHead, w: &WideContact) -> WideDerived {
 }
 
 // What the hot passes stream per group of four constraints (bytes).
+const _: () = assert!(core::mem::size_of::<WideDerived>() == 112);
 const _: () = assert!(core::mem::size_of::<WideContact>() == 400);
 const _: () = assert!(core::mem::size_of::<WideHead>() == 416);
 
@@ -1155,11 +1160,14 @@ impl StoredGroup {
     }
 }
 
-/// Copies a scalar constraint into lane `l` (everything: geometry, masses, state).
+/// Copies a scalar constraint into lane `l` (everything: geometry, masses, state) and
+/// makes the group's `derived` part again.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn pack(
     h: &mut WideHead,
     w: &mut WideContact,
     cold: &mut WideCold,
+    derived: &mut WideDerived,
     l: usize,
     cc: &ContactConstraint,
     dynamic_a: bool,
@@ -1247,6 +1255,7 @@ pub(crate) fn pack(
     w.mu[l] = if stick { cc.mu_s } else { cc.mu_d };
     h.two_points[l] = if cc.count == 2 { u32::MAX } else { 0 };
     pack_state(h, w, l, cc);
+    *derived = derive(h, w);
 }
 
 /// Copies the parts of a constraint that change during the substeps into lane `l`.
@@ -1501,9 +1510,13 @@ mod tests {
         let f = fixture();
         let (ctx, soft, states, up, cases) = (f.ctx, f.soft, &f.states, f.up, &f.cases);
         let (h, w, cold, dv) = built(f.lanes(), up, &ctx, states);
-        // The ready-made part is what the group derives (what a pack makes again).
-        assert_eq!(format!("{dv:?}"), format!("{:?}", derive(&h, &w)));
+        // Packed lane by lane over a copy whose ready-made part is spoilt first: pack must
+        // make it again.
         let (mut rh, mut r, mut rcold) = (h, w, cold);
+        let mut rdv = WideDerived {
+            i12: F4::splat(7.0),
+            ..dv
+        };
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
             let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
             let dyn_side = |m: f32, i: f32| m > 0.0 || i > 0.0;
@@ -1511,6 +1524,7 @@ mod tests {
                 &mut rh,
                 &mut r,
                 &mut rcold,
+                &mut rdv,
                 l,
                 &cc,
                 dyn_side(b.inv_mass_a, b.inv_i_a),
@@ -1520,6 +1534,21 @@ mod tests {
         assert_eq!(format!("{h:?}"), format!("{rh:?}"));
         assert_eq!(format!("{w:?}"), format!("{r:?}"));
         assert_eq!(format!("{cold:?}"), format!("{rcold:?}"));
+        assert_eq!(format!("{dv:?}"), format!("{rdv:?}"));
+        // The ready-made part, lane by lane from the scalar build: the friction row at the
+        // middle of two points (at the point of one), K⁻¹ from the block's K and 1/det K
+        // (zeros, the middle one −0, where the block does not apply), to the bit.
+        for (l, (ci, inp, b)) in cases.iter().enumerate() {
+            let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
+            let [p0, p1] = &cc.points;
+            let anchor = |a: Vec2, b: Vec2| if cc.count == 2 { (a + b) * 0.5 } else { a };
+            let (fr_a, fr_b) = (anchor(p0.r_a, p1.r_a), anchor(p0.r_b, p1.r_b));
+            let block = cc.count == 2 && cc.block;
+            let ([k11, k12, k22], inv) = if block { (cc.k, cc.inv_det) } else { ([0.0; 3], 0.0) };
+            let expected = [fr_a.x, fr_a.y, fr_b.x, fr_b.y, k22 * inv, -k12 * inv, k11 * inv];
+            let lane = [dv.fr_a.x, dv.fr_a.y, dv.fr_b.x, dv.fr_b.y, dv.i11, dv.i12, dv.i22].map(|x| x[l]);
+            assert_eq!(lane.map(f32::to_bits), expected.map(f32::to_bits), "lane {l}");
+        }
         // What the lanes derive instead of storing (softness, K⁻¹, rolling mass, friction
         // coefficient) comes back as the scalar build made it.
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
