@@ -1200,9 +1200,15 @@ impl ConstraintSet for ContactSolver {
         }
         // Four lanes at once; a group's lanes share no moving body (one colour), and the
         // groups run in order, as the scalar loop ran.
-        for ((h, w), cold) in self.head.iter_mut().zip(self.wide.iter_mut()).zip(&self.cold) {
+        let groups = self
+            .head
+            .iter_mut()
+            .zip(self.wide.iter_mut())
+            .zip(&self.derived)
+            .zip(&self.cold);
+        for (((h, w), dv), cold) in groups {
             if cold.any_restitution {
-                contact_wide::restitution(h, w, cold, states);
+                contact_wide::restitution(h, w, dv, cold, states);
             }
         }
     }

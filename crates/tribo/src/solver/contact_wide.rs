@@ -235,13 +235,21 @@ pub(crate) struct WideDerived {
 /// same bits.
 #[inline(always)]
 pub(crate) fn derive(h: &WideHead, w: &WideContact) -> WideDerived {
-    let (fr_a, fr_b) = friction_arms(h);
-    WideDerived {
-        fr_a,
-        fr_b,
-        i11: w.k22 * w.inv_det,
-        i12: -w.k12 * w.inv_det,
-        i22: w.k11 * w.inv_det,
+    WideDerived::new(friction_arms(h), w)
+}
+
+impl WideDerived {
+    /// From the group's friction anchors `(fr_a, fr_b)` ([`friction_arms`]) and its K and
+    /// 1/det K.
+    #[inline(always)]
+    fn new((fr_a, fr_b): (V4, V4), w: &WideContact) -> WideDerived {
+        WideDerived {
+            fr_a,
+            fr_b,
+            i11: w.k22 * w.inv_det,
+            i12: -w.k12 * w.inv_det,
+            i22: w.k11 * w.inv_det,
+        }
     }
 }
 
@@ -431,7 +439,13 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
 /// that do not bounce keep their impulses and velocities bit for bit. Unpacking each
 /// bouncing lane into a scalar constraint cost 1.4 ms of a 24 ms step in Box2D's spinner,
 /// where half the lanes bounce.
-pub(crate) fn restitution<S: StateCell>(h: &mut WideHead, w: &mut WideContact, cold: &WideCold, states: &[S]) {
+pub(crate) fn restitution<S: StateCell>(
+    h: &mut WideHead,
+    w: &mut WideContact,
+    dv: &WideDerived,
+    cold: &WideCold,
+    states: &[S],
+) {
     let zero = F4::ZERO;
     let e = F4::new(cold.restitution);
     let minus_threshold = -F4::new(cold.restitution_threshold);
@@ -478,7 +492,7 @@ pub(crate) fn restitution<S: StateCell>(h: &mut WideHead, w: &mut WideContact, c
         let rhs0 = normal_velocity(&a, &b, 0) + e * w.points[0].approach;
         let rhs1 = normal_velocity(&a, &b, 1) + e * w.points[1].approach;
         let (k11, k12, k22) = (w.k11, w.k12, w.k22);
-        let (i11, i12, i22) = (k22 * w.inv_det, -k12 * w.inv_det, k11 * w.inv_det);
+        let (i11, i12, i22) = (dv.i11, dv.i12, dv.i22);
         let (one, none) = (F4::splat(1.0), F4::ZERO);
         let soft0 = |rd: F4| lam0 + one * rd - none * (lam0 - pre0);
         let soft1 = |rd: F4| lam1 + one * rd - none * (lam1 - pre1);
@@ -960,7 +974,7 @@ pub(crate) fn build_group<S: StateRead>(
     out.k12 = block.select(k12, zero);
     out.k22 = block.select(k22, zero);
     out.inv_det = block.select(inv, zero);
-    *derived = derive(hd, out);
+    *derived = WideDerived::new((fr_a, fr_b), out);
 }
 
 /// `contact_solver::shift_cap2` four lanes at once (the same quotients and minimum; the
@@ -1795,7 +1809,7 @@ mod tests {
             Some((cases[2].0, &cases[2].1, &cases[2].2)),
             None,
         ];
-        let (mut h, mut w, mut cold, _) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
+        let (mut h, mut w, mut cold, dv) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
         // Impact speeds and loads as the substeps would leave them: every point bounces but
         // lane 2's second (slower than the 1 m/s threshold); lane 1 had little energy.
         for (i, approach) in [[-3.0, -2.0, -2.5, 0.0], [-2.5, 0.0, -0.5, 0.0]]
@@ -1818,7 +1832,7 @@ mod tests {
         }
         let wide: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
         let before = (h, w);
-        restitution(&mut h, &mut w, &cold, &wide);
+        restitution(&mut h, &mut w, &dv, &cold, &wide);
         let bits = |s: BodyState| [s.v.x, s.v.y, s.w].map(f32::to_bits);
         for (k, (x, y)) in wide.iter().zip(&scalar).enumerate() {
             assert_eq!(bits(x.get()), bits(y.get()), "body {k}");
@@ -1840,7 +1854,7 @@ mod tests {
         let (mut free_h, mut free_w, mut free_cold) = (before.0, before.1, cold);
         free_cold.kinetic_energy[1] = 1e6;
         let fresh: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
-        restitution(&mut free_h, &mut free_w, &free_cold, &fresh);
+        restitution(&mut free_h, &mut free_w, &dv, &free_cold, &fresh);
         let lam = before.0.points[0].normal_impulse[1];
         let (capped, free) = (
             h.points[0].normal_impulse[1] - lam,
