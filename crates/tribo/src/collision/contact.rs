@@ -22,7 +22,12 @@ pub enum FrictionState {
 }
 
 /// What persists for one manifold point between steps (matched by feature id).
+///
+/// `repr(C)`, the eight floats first in the order of [`PointState::set_stored`]: the
+/// impulse store writes them as two 16-byte rows per point, straight from the transpose
+/// of its lanes.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
 pub(crate) struct PointState {
     /// Normal impulse of the last substep [N·s] (warm start).
     pub normal_impulse: f32,
@@ -34,10 +39,6 @@ pub(crate) struct PointState {
     pub total_tangent_impulse: f32,
     /// Largest normal impulse of any substep [N·s]; > 0 means the point carried load.
     pub max_normal_impulse: f32,
-    /// Stick or slip.
-    pub state: FrictionState,
-    /// True until the point has been through one solver step.
-    pub fresh: bool,
     /// Tangential slip [m] accumulated while sticking (the static-friction anchor): the
     /// solver drives it back to zero, so a sticking body cannot creep.
     pub drift: f32,
@@ -46,6 +47,32 @@ pub(crate) struct PointState {
     /// Normal impulse per substep [N·s] the soft contact relaxes towards (a slowly
     /// tracking average of the manifold's load, so a steady load needs no deflection).
     pub preload: f32,
+    /// Stick or slip.
+    pub state: FrictionState,
+    /// True until the point has been through one solver step.
+    pub fresh: bool,
+}
+
+impl PointState {
+    /// Sets what the impulse store writes: `impulses` = (normal, tangent, total normal,
+    /// total tangent) [N·s], `rest` = (max normal [N·s], drift [m], slip speed [m/s],
+    /// preload [N·s]), the friction state, and `fresh` off. Field by field in layout order,
+    /// so each row compiles to one 16-byte store.
+    #[inline(always)]
+    pub fn set_stored(&mut self, impulses: [f32; 4], rest: [f32; 4], state: FrictionState) {
+        let [normal, tangent, total_normal, total_tangent] = impulses;
+        let [max, drift, slip_speed, preload] = rest;
+        self.normal_impulse = normal;
+        self.tangent_impulse = tangent;
+        self.total_normal_impulse = total_normal;
+        self.total_tangent_impulse = total_tangent;
+        self.max_normal_impulse = max;
+        self.drift = drift;
+        self.slip_speed = slip_speed;
+        self.preload = preload;
+        self.state = state;
+        self.fresh = false;
+    }
 }
 
 /// [`Contact::colour`] of a contact not yet solved, or solved in the overflow list.
