@@ -1002,20 +1002,20 @@ impl StoredContact {
     /// impulse).
     #[inline]
     pub(crate) fn write_into(&self, c: &mut Contact) {
-        write_stored(c, self.count, self.rolling_impulse, |i| self.points[i]);
+        write_stored(c, self.count, self.rolling_impulse, |i, ps| *ps = self.points[i]);
     }
 }
 
-/// Writes a contact's stored states: point `i`'s state `point(i)` for each of its `count`
-/// points (fixed-size writes: a slice copy of variable length is a `memcpy` call) and its
-/// rolling impulse.
+/// Writes a contact's stored states: `set(i, point)` sets point `i` in place for each of
+/// its `count` points (fixed-size writes: a slice copy of variable length is a `memcpy`
+/// call), then its rolling impulse.
 #[inline(always)]
-fn write_stored(c: &mut Contact, count: u8, rolling_impulse: f32, point: impl Fn(usize) -> PointState) {
+fn write_stored(c: &mut Contact, count: u8, rolling_impulse: f32, set: impl Fn(usize, &mut PointState)) {
     if count >= 1 {
-        c.points[0] = point(0);
+        set(0, &mut c.points[0]);
     }
     if count >= 2 {
-        c.points[1] = point(1);
+        set(1, &mut c.points[1]);
     }
     c.rolling_impulse = rolling_impulse;
 }
@@ -1180,14 +1180,9 @@ impl StoredGroup {
     /// Writes lane `l` into its contact (the manifold's points and the rolling impulse).
     #[inline(always)]
     pub(crate) fn write_into(&self, l: usize, c: &mut Contact) {
-        let count = self.count[l];
-        if count >= 1 {
-            self.set_point(0, l, &mut c.points[0]);
-        }
-        if count >= 2 {
-            self.set_point(1, l, &mut c.points[1]);
-        }
-        c.rolling_impulse = self.rolling_impulse[l];
+        write_stored(c, self.count[l], self.rolling_impulse[l], |i, ps| {
+            self.set_point(i, l, ps)
+        });
     }
 
     /// Lane `l` as a record of its own (for a contact written later, on one thread).
