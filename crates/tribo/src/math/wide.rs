@@ -301,7 +301,7 @@ impl F4 {
         )
     }
 
-    /// Lane-wise minimum.
+    /// Lane-wise minimum (`a < b ? a : b`, SSE `minps`: `b` where either is NaN).
     #[inline(always)]
     pub fn min(self, o: F4) -> F4 {
         simd!(

@@ -143,10 +143,49 @@ fn max_separation(p1: &LocalPoly, p2: &LocalPoly) -> (usize, f32) {
     // At most four vertices: four separations per edge (the padded vertex 0 changes no
     // minimum).
     if p2.count <= 4 {
-        max_separation_of::<4>(p1, p2)
+        max_separation_rows::<false>(p1, p2)
     } else {
-        max_separation_of::<MAX_POLYGON_VERTICES>(p1, p2)
+        max_separation_rows::<true>(p1, p2)
     }
+}
+
+/// [`max_separation`] one edge of `p1` at a time, with `p2`'s vertices as lanes: its
+/// first four (padded with vertex 0), and with `WIDE` its next four as a second group.
+/// Each edge's separations are one or two lane-wise expressions (`n · (p2.v[j] − v)`, as
+/// `Vec2::dot`) and its minimum the tree of the scalar reference
+/// (`max_separation_of`): the same bits. For the junkyard's pentagons this takes 218
+/// instructions a call; the scalar eight-slot path took 335, computing the eight
+/// separations of an edge one at a time (junkyard, 300 steps: 17.78 → 17.49 G
+/// instructions).
+#[inline(always)]
+fn max_separation_rows<const WIDE: bool>(p1: &LocalPoly, p2: &LocalPoly) -> (usize, f32) {
+    let vertex = |j: usize| p2.v[if j < p2.count { j } else { 0 }];
+    let (x0, y0) = split_xy([vertex(0), vertex(1), vertex(2), vertex(3)]);
+    let (x1, y1) = if WIDE {
+        split_xy([vertex(4), vertex(5), vertex(6), vertex(7)])
+    } else {
+        (x0, y0)
+    };
+    let lesser = |a: f32, b: f32| if b < a { b } else { a };
+    let mut best_edge = 0;
+    let mut best = f32::MIN;
+    for i in 0..p1.count.min(MAX_POLYGON_VERTICES) {
+        let (n, v) = (p1.n[i], p1.v[i]);
+        let (nx, ny, vx, vy) = (F4::splat(n.x), F4::splat(n.y), F4::splat(v.x), F4::splat(v.y));
+        let d = nx * (x0 - vx) + ny * (y0 - vy);
+        // Lane j: the reference's `lesser(d[j], d[j + 4])` (`lesser(a, b)` is `b.min(a)`).
+        let half = if WIDE {
+            (nx * (x1 - vx) + ny * (y1 - vy)).min(d)
+        } else {
+            d
+        };
+        let si = lesser(lesser(half[0], half[1]), lesser(half[2], half[3]));
+        if si > best {
+            best = si;
+            best_edge = i;
+        }
+    }
+    (best_edge, best)
 }
 
 /// [`max_separation`] of two polygons of at most four edges and exactly four vertices
@@ -166,7 +205,8 @@ fn max_separation_4x4(p1: &LocalPoly, p2: &LocalPoly) -> (usize, f32) {
     });
     // Lane i of column j: vertex j's separation from edge i.
     let [d0, d1, d2, d3] = transpose(rows);
-    let lesser = |a: F4, b: F4| b.lt(a).select(b, a);
+    // The scalar `lesser(a, b)` (`b < a ? b : a`) is `b.min(a)`, one `minps`.
+    let lesser = |a: F4, b: F4| b.min(a);
     let si = lesser(lesser(d0, d1), lesser(d2, d3));
     let mut best_edge = 0;
     let mut best = f32::MIN;
@@ -179,8 +219,9 @@ fn max_separation_4x4(p1: &LocalPoly, p2: &LocalPoly) -> (usize, f32) {
     (best_edge, best)
 }
 
-/// [`max_separation`] over the first `N` (4 or 8) vertex slots of `p2`.
-#[inline(always)]
+/// [`max_separation`] over the first `N` (4 or 8) vertex slots of `p2`, one edge at a
+/// time: the scalar reference the wide paths are tested against.
+#[cfg(test)]
 fn max_separation_of<const N: usize>(p1: &LocalPoly, p2: &LocalPoly) -> (usize, f32) {
     let vertex = |j: usize| p2.v[if j < p2.count { j } else { 0 }];
     let xs: [f32; N] = core::array::from_fn(|j| vertex(j).x);
@@ -339,7 +380,7 @@ pub(super) fn collide_polygons(
 mod tests {
     use super::super::test_support::*;
     use super::super::{collide, Manifold};
-    use super::{max_separation_4x4, max_separation_of, LocalPoly};
+    use super::{max_separation, max_separation_4x4, max_separation_of, LocalPoly};
     use crate::geometry::MAX_POLYGON_VERTICES;
     use crate::geometry::{Polygon, Shape, SPECULATIVE_DISTANCE};
     use crate::math::{Transform, Vec2};
@@ -413,6 +454,52 @@ mod tests {
         assert_eq!(tied.len(), 2, "the fixture ties two edges");
         check(&base, &corner);
         assert_eq!(max_separation_4x4(&base, &corner).0, tied[0]);
+    }
+
+    /// `max_separation` gives the bits of the scalar reference for every pair of vertex
+    /// counts it dispatches on (a polygon of 2 to 8 vertices against one of 2 to 8):
+    /// random convex polygons (the hull of points on a circle) at random poses.
+    #[test]
+    fn lane_separations_match_the_scalar_reference() {
+        let mut seed = 777u32;
+        let mut next = move || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1u32 << 24) as f32
+        };
+        let polygon = |count: usize, xf: Transform, next: &mut dyn FnMut() -> f32| -> LocalPoly {
+            if count == 2 {
+                return LocalPoly::from_segment(xf.p, xf.apply(Vec2::new(0.3 + next(), 0.2)), 0.05);
+            }
+            // Points on one circle, each in its own sector, so the hull keeps them all.
+            let radius = 0.2 + next();
+            let points: Vec<Vec2> = (0..count)
+                .map(|k| {
+                    let angle = (k as f32 + 0.2 + 0.6 * next()) * core::f32::consts::TAU / count as f32;
+                    Vec2::new(angle.cos(), angle.sin()) * radius
+                })
+                .collect();
+            let p = Polygon::from_points(&points, 0.0).unwrap();
+            assert_eq!(p.count(), count, "the fixture keeps every point");
+            LocalPoly::from_polygon(&p, xf)
+        };
+        for _ in 0..40 {
+            for c1 in 2..=MAX_POLYGON_VERTICES {
+                for c2 in 2..=MAX_POLYGON_VERTICES {
+                    let p1 = polygon(c1, Transform::new(Vec2::ZERO, 6.3 * next()), &mut next);
+                    let at = Vec2::new(2.0 * next() - 1.0, 2.0 * next() - 1.0);
+                    let p2 = polygon(c2, Transform::new(at, 6.3 * next()), &mut next);
+                    let (e, s) = max_separation(&p1, &p2);
+                    let (er, sr) = max_separation_of::<MAX_POLYGON_VERTICES>(&p1, &p2);
+                    assert_eq!(
+                        (e, s.to_bits()),
+                        (er, sr.to_bits()),
+                        "{c1} vs {c2}: {:?} vs {:?}",
+                        (e, s),
+                        (er, sr)
+                    );
+                }
+            }
+        }
     }
 
     #[test]
