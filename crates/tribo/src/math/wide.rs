@@ -403,6 +403,24 @@ pub(crate) fn split_xy(p: [Vec2; LANES]) -> (F4, F4) {
     )
 }
 
+/// The inverse of [`split_xy`]: four points from lanes of x and of y (four shuffles).
+#[inline(always)]
+pub(crate) fn join_xy(x: F4, y: F4) -> [Vec2; LANES] {
+    let [a, b]: [[f32; LANES]; 2] = simd!(
+        {
+            let (x, y) = (sse::f(x), sse::f(y));
+            [*sse::to_f(_mm_unpacklo_ps(x, y)), *sse::to_f(_mm_unpackhi_ps(x, y))]
+        },
+        [[x[0], y[0], x[1], y[1]], [x[2], y[2], x[3], y[3]]]
+    );
+    [
+        Vec2::new(a[0], a[1]),
+        Vec2::new(a[2], a[3]),
+        Vec2::new(b[0], b[1]),
+        Vec2::new(b[2], b[3]),
+    ]
+}
+
 /// `Transform::apply` lane by lane, its expression in its order, so every lane has the
 /// scalar bits: `(c x − s y) + t.x`, `(s x + c y) + t.y` for the points `(x, y)`, each lane
 /// with its own rotation `(c, s)` and translation `(t.x, t.y)`.
