@@ -980,10 +980,16 @@ impl World {
     /// dynamic body that moved out of the region its pairs covered, or a fast swept one, at
     /// the first static shape in its way ([`World::stop_at_static_shapes`]).
     pub(crate) fn refresh_body_proxies(&mut self, body_index: u32, dt: f32, sweep: bool) {
-        if let Some(escaped) = self.refresh_boxes(body_index, dt, 0, true, sweep) {
-            // A shape ended the step outside the fat box its pairs were found with.
-            let moved = self.stop_at_static_shapes(body_index);
-            self.refresh_boxes(body_index, dt, if moved { 0 } else { escaped }, false, sweep);
+        if let Some(escaped) = self.refresh_boxes(body_index, dt, 0, None, true, sweep) {
+            // A shape ended the step outside the fat box its pairs were found with. Its box
+            // at the new pose serves the check and, if the body stays there, the update
+            // (a polygon's box is some 140 instructions; the junkyard's falling pentagons
+            // escape by the thousand each step).
+            if self.stop_at_static_shapes(body_index, escaped) {
+                self.refresh_boxes(body_index, dt, 0, None, false, sweep);
+            } else {
+                self.refresh_boxes(body_index, dt, escaped.0, Some(escaped.1), false, sweep);
+            }
         }
     }
 
@@ -991,9 +997,18 @@ impl World {
     /// `check` (and `dt` > 0, for a dynamic body) it first compares each shape's box at the
     /// body's new pose with the fat box its pairs were found with, and stops at the first
     /// one that left it by more than the speculative distance plus the slop, returning its
-    /// position in the body's shape list (the shapes before it are updated); the box is
-    /// computed once either way.
-    fn refresh_boxes(&mut self, body_index: u32, dt: f32, first: usize, check: bool, sweep: bool) -> Option<usize> {
+    /// position in the body's shape list and its box at the new pose (the shapes before it
+    /// are updated); the box is computed once either way. `known`: the `first` shape's box
+    /// at the body's pose, when the caller has it.
+    fn refresh_boxes(
+        &mut self,
+        body_index: u32,
+        dt: f32,
+        first: usize,
+        known: Option<Aabb>,
+        check: bool,
+        sweep: bool,
+    ) -> Option<(usize, Aabb)> {
         // Disjoint field borrows: no copy of the shape list in this per-step path.
         let Some(b) = self.bodies.at(body_index) else {
             return None;
@@ -1007,8 +1022,12 @@ impl World {
             let Some(s) = self.shapes.at_mut(index) else {
                 continue;
             };
-            let Some(aabb) = next_box(s, xf, v, dt, check, sweep, moved) else {
-                return Some(k);
+            let tight = match known.filter(|_| k == first) {
+                Some(tight) => tight,
+                None => s.geometry.aabb(xf),
+            };
+            let Some(aabb) = next_box(s, tight, v, dt, check, sweep, moved) else {
+                return Some((k, tight));
             };
             s.aabb = aabb;
             if !s.fat_aabb.contains(aabb) || dt == 0.0 {
@@ -1257,7 +1276,7 @@ pub(crate) fn box_velocity(b: &Body, limit: f32) -> Vec2 {
     }
 }
 
-/// A shape's box for the next step at the body's pose `xf` (swept along `v` for `dt` when
+/// A shape's box for the next step from `tight`, its box at the body's new pose (swept along `v` for `dt` when
 /// `sweep`, see [`sweep_free`]), or `None` when `check` finds that the body must first be
 /// checked against static shapes ([`World::stop_at_static_shapes`]):
 /// - the shape escaped: a static shape the body has no pair with had its fat box (its box
@@ -1270,14 +1289,13 @@ pub(crate) fn box_velocity(b: &Body, limit: f32) -> Vec2 {
 ///   from where the body arrives), so fast bodies are checked as Box2D checks them.
 pub(crate) fn next_box(
     s: &ShapeRecord,
-    xf: Transform,
+    tight: Aabb,
     v: Vec2,
     dt: f32,
     check: bool,
     sweep: bool,
     moved: f32,
 ) -> Option<Aabb> {
-    let tight = s.geometry.aabb(xf);
     if check && !s.fat_aabb.expand(SPECULATIVE_DISTANCE + LINEAR_SLOP).contains(tight) {
         return None;
     }

@@ -917,7 +917,15 @@ impl World {
                     let check = b.body_type == BodyType::Dynamic;
                     let sweep = b.bullet || !touched[k];
                     let moved = (b.center - b.center0).length();
-                    let next = next_box(s, b.xf, box_velocity(b, limit), dt, check, sweep, moved);
+                    let next = next_box(
+                        s,
+                        s.geometry.aabb(b.xf),
+                        box_velocity(b, limit),
+                        dt,
+                        check,
+                        sweep,
+                        moved,
+                    );
                     if let Some(aabb) = next.filter(|aabb| s.fat_aabb.contains(*aabb)) {
                         s.aabb = aabb;
                         (bounds.aabb, bounds.fat_aabb) = (aabb, s.fat_aabb);

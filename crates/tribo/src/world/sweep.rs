@@ -17,14 +17,15 @@ use crate::collision::broad_phase::STATIC_TREE;
 use crate::collision::contact::pair_key;
 use crate::dynamics::body::Body;
 use crate::geometry::{first_contact, Sweep};
+use crate::math::Aabb;
 
 impl World {
     /// Moves a body back along this step's motion to where it first overlaps, by more than
     /// the linear slop, a static shape it may collide with (filters and joints respected)
     /// and had no contact points with this step. Its velocity is unchanged. Returns whether it moved.
-    pub(crate) fn stop_at_static_shapes(&mut self, body_index: u32) -> bool {
+    pub(crate) fn stop_at_static_shapes(&mut self, body_index: u32, known: (usize, Aabb)) -> bool {
         let mut found = core::mem::take(&mut self.scratch_found);
-        let first = self.first_static_contact(body_index, &mut found);
+        let first = self.first_static_contact(body_index, known, &mut found);
         self.scratch_found = found;
         match first {
             Some((first, sweep)) if first < 1.0 => {
@@ -41,8 +42,14 @@ impl World {
     }
 
     /// The first fraction of this step's motion at which the body overlaps a static shape
-    /// it had no contact points with (1 when none), and the motion; `found` is scratch.
-    fn first_static_contact(&self, body_index: u32, found: &mut Vec<u32>) -> Option<(f32, Sweep)> {
+    /// it had no contact points with (1 when none), and the motion; `known`: one shape's
+    /// position in the body's list and its box at the body's pose; `found` is scratch.
+    fn first_static_contact(
+        &self,
+        body_index: u32,
+        known: (usize, Aabb),
+        found: &mut Vec<u32>,
+    ) -> Option<(f32, Sweep)> {
         let tree = &self.broad_phase.trees[STATIC_TREE as usize];
         let b = self.bodies.at(body_index)?;
         if tree.proxy_count() == 0 {
@@ -63,7 +70,8 @@ impl World {
             // last refresh holds it) and at the end pose, grown by the most a point strays
             // from the chord between its two end positions during the turn (the body's
             // reach bounds each shape's).
-            let swept = s.aabb.union(s.geometry.aabb(b.xf)).expand(bulge);
+            let end = if k == known.0 { known.1 } else { s.geometry.aabb(b.xf) };
+            let swept = s.aabb.union(end).expand(bulge);
             found.clear();
             tree.query(swept, s.filter.mask, |_, data| {
                 found.push(data as u32);
