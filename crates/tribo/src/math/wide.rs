@@ -706,13 +706,16 @@ impl Sub for V4 {
 mod tests {
     use super::*;
 
-    /// `split_xy` gathers the x and the y of four points, in order.
+    /// `split_xy` gathers the x and the y of four points, in order, and `join_xy` puts
+    /// them back.
     #[test]
     fn split_xy_gathers_the_coordinates_of_four_points() {
         let v = Vec2::new;
-        let (x, y) = split_xy([v(1.0, 2.0), v(3.0, 4.0), v(5.0, 6.0), v(7.0, 8.0)]);
+        let points = [v(1.0, 2.0), v(3.0, 4.0), v(5.0, 6.0), v(7.0, 8.0)];
+        let (x, y) = split_xy(points);
         assert_eq!(*x, [1.0, 3.0, 5.0, 7.0]);
         assert_eq!(*y, [2.0, 4.0, 6.0, 8.0]);
+        assert_eq!(join_xy(x, y), points);
     }
 
     #[test]

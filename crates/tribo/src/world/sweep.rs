@@ -67,9 +67,11 @@ impl World {
                 continue;
             };
             // Every pose of the motion: the box at the start pose (the shape's box from the
-            // last refresh holds it) and at the end pose, grown by the most a point strays
-            // from the chord between its two end positions during the turn (the body's
-            // reach bounds each shape's).
+            // last refresh holds it, for the escaped shape and those after it; a shape
+            // before it already has its new box there, but it did not escape: see
+            // `world::next_box`) and at the end pose, grown by the most a point strays from
+            // the chord between its two end positions during the turn (the body's reach
+            // bounds each shape's).
             let end = if k == known.0 { known.1 } else { s.geometry.aabb(b.xf) };
             let swept = s.aabb.union(end).expand(bulge);
             found.clear();

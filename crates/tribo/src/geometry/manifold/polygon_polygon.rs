@@ -69,6 +69,7 @@ impl LocalPoly {
         let (tx, ty) = (F4::splat(xf.p.x), F4::splat(xf.p.y));
         // Four slots at a time, each lane `Rot::rotate` (and `Transform::apply`) in its
         // order: the scalar bits.
+        // (`first` is 0 or 4; the modulo only spares the bounds checks.)
         let moved = |q: &[Vec2; MAX_POLYGON_VERTICES], first: usize, shift: bool| {
             let (x, y) = split_xy(core::array::from_fn(|k| q[(first + k) % MAX_POLYGON_VERTICES]));
             let (rx, ry) = (c * x - s * y, s * x + c * y);
@@ -124,13 +125,13 @@ impl LocalPoly {
     }
 }
 
-/// Edge of `p1` with the largest separation of `p2` from it, and that separation [m].
-///
-/// For each edge the separations of all of `p2`'s vertices are computed as one array
-/// (`p2` padded with its first vertex, which changes no minimum) and reduced by a tree of
-/// plain comparisons: straight-line code the compiler turns into SIMD, where a loop of
-/// `f32::min` (NaN-aware: five instructions per vertex) took 60 % of the polygon collision
-/// (tumbler, 300 steps: 412 M → 252 M instructions).
+/// Edge of `p1` with the largest separation of `p2` from it, and that separation [m]:
+/// [`max_separation_4x4`] for a box against a polygon of at most four edges, otherwise
+/// [`max_separation_rows`] (one edge at a time, `p2`'s vertices as lanes). Both give the
+/// bits of the scalar reference `max_separation_of` (each edge's separations from all of
+/// `p2`'s vertices, `p2` padded with its first vertex, which changes no minimum, reduced
+/// by a tree of plain comparisons; a loop of NaN-aware `f32::min`, five instructions per
+/// vertex, had taken 60 % of the polygon collision).
 fn max_separation(p1: &LocalPoly, p2: &LocalPoly) -> (usize, f32) {
     if p2.count == 4 && p1.count <= 4 {
         return max_separation_4x4(p1, p2);
@@ -188,8 +189,8 @@ fn max_separation_rows<const WIDE: bool>(p1: &LocalPoly, p2: &LocalPoly) -> (usi
 /// edge of `p1` (`p2`'s coordinates deinterleaved once), transposed so that one tree of
 /// three lane-wise `lesser`s gives every edge's minimum at once. Every lane is the
 /// scalar path's expression and its tree in its order, so the result is the same bits
-/// (tumbler: 166 instructions a call, most of them building the padded vertex arrays and
-/// reducing each edge alone).
+/// (tumbler: the scalar path took 166 instructions a call, most of them building the
+/// padded vertex arrays and reducing each edge alone).
 #[inline(always)]
 fn max_separation_4x4(p1: &LocalPoly, p2: &LocalPoly) -> (usize, f32) {
     let (xs, ys) = split_xy([p2.v[0], p2.v[1], p2.v[2], p2.v[3]]);
@@ -482,17 +483,58 @@ mod tests {
                 for c2 in 2..=MAX_POLYGON_VERTICES {
                     let p1 = polygon(c1, Transform::new(Vec2::ZERO, 6.3 * next()), &mut next);
                     let at = Vec2::new(2.0 * next() - 1.0, 2.0 * next() - 1.0);
-                    let p2 = polygon(c2, Transform::new(at, 6.3 * next()), &mut next);
-                    let (e, s) = max_separation(&p1, &p2);
-                    let (er, sr) = max_separation_of::<MAX_POLYGON_VERTICES>(&p1, &p2);
-                    assert_eq!(
-                        (e, s.to_bits()),
-                        (er, sr.to_bits()),
-                        "{c1} vs {c2}: {:?} vs {:?}",
-                        (e, s),
-                        (er, sr)
-                    );
+                    let mut p2 = polygon(c2, Transform::new(at, 6.3 * next()), &mut next);
+                    // Slots past the count hold a far corner (each of the four in turn), so
+                    // a path that read them instead of padding with vertex 0 would find a
+                    // much smaller separation for some edge.
+                    for corner in [(1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)] {
+                        for slot in &mut p2.v[c2..] {
+                            *slot = Vec2::new(corner.0, corner.1) * 1.0e6;
+                        }
+                        let (e, s) = max_separation(&p1, &p2);
+                        let (er, sr) = max_separation_of::<MAX_POLYGON_VERTICES>(&p1, &p2);
+                        assert_eq!(
+                            (e, s.to_bits()),
+                            (er, sr.to_bits()),
+                            "{c1} vs {c2}: {:?} vs {:?}",
+                            (e, s),
+                            (er, sr)
+                        );
+                    }
                 }
+            }
+        }
+    }
+
+    /// `LocalPoly::from_polygon` moves every slot it keeps as `Transform::apply` (vertices)
+    /// and `Rot::rotate` (normals) do, bit for bit, and leaves the slots of a polygon of at
+    /// most four vertices past four zero.
+    #[test]
+    fn moved_polygon_has_the_scalar_bits() {
+        for count in 3..=MAX_POLYGON_VERTICES {
+            let points: Vec<Vec2> = (0..count)
+                .map(|k| {
+                    let angle = (k as f32 + 0.37) * core::f32::consts::TAU / count as f32;
+                    Vec2::new(0.7 * angle.cos() + 0.1, 0.7 * angle.sin() - 0.2)
+                })
+                .collect();
+            let p = Polygon::from_points(&points, 0.01).unwrap();
+            let xf = Transform::new(Vec2::new(1.25, -3.5), 0.9 + count as f32);
+            let moved = LocalPoly::from_polygon(&p, xf);
+            assert_eq!(moved.count, count);
+            let kept = if count <= 4 { 4 } else { MAX_POLYGON_VERTICES };
+            for k in 0..MAX_POLYGON_VERTICES {
+                let (v, n) = if k < kept {
+                    (xf.apply(p.vertices[k]), xf.q.rotate(p.normals[k]))
+                } else {
+                    (Vec2::ZERO, Vec2::ZERO)
+                };
+                let bits = |w: Vec2| (w.x.to_bits(), w.y.to_bits());
+                assert_eq!(
+                    (bits(moved.v[k]), bits(moved.n[k])),
+                    (bits(v), bits(n)),
+                    "{count} slot {k}"
+                );
             }
         }
     }
