@@ -487,6 +487,7 @@ impl Shape {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::manifold::test_support::uniform;
     use crate::math::Rot;
 
     fn v(x: f32, y: f32) -> Vec2 {
@@ -676,11 +677,7 @@ mod tests {
             Aabb::new(lo, hi).expand(p.radius)
         };
         let bits = |b: Aabb| [b.min.x, b.min.y, b.max.x, b.max.y].map(f32::to_bits);
-        let mut seed = 0x2545_f491u32;
-        let mut next = move || {
-            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (seed >> 8) as f32 / (1u32 << 24) as f32
-        };
+        let mut next = uniform(0x2545_f491);
         let mut cases = Vec::new();
         for _ in 0..500 {
             let p = Polygon::new_rounded_box(0.05 + next(), 0.05 + next(), 0.1 * next()).unwrap();

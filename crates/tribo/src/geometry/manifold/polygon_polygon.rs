@@ -397,29 +397,27 @@ mod tests {
         v
     }
 
+    /// Asserts that `got` is the scalar reference's (edge, separation), bit for bit.
+    fn same_separation(got: (usize, f32), p1: &LocalPoly, p2: &LocalPoly, what: &str) {
+        let want = max_separation_of::<MAX_POLYGON_VERTICES>(p1, p2);
+        assert_eq!(
+            (got.0, got.1.to_bits()),
+            (want.0, want.1.to_bits()),
+            "{what}: {got:?} vs {want:?}"
+        );
+    }
+
     /// `max_separation_4x4` gives the bits the eight-wide path gives (the same
     /// expressions and minimum tree, every edge of `p1`): boxes of every size against
     /// boxes, triangles and segments as `p1`, at 200 poses, and an exact tie of two
     /// edges, where the first must win.
     #[test]
     fn four_by_four_separations_match_the_eight_wide_path() {
-        let mut seed = 12345u32;
-        let mut next = move || {
-            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (seed >> 8) as f32 / (1u32 << 24) as f32
-        };
+        let mut next = uniform(12345);
         let tri = Polygon::from_points(&[Vec2::new(-0.5, 0.0), Vec2::new(0.5, 0.0), Vec2::new(0.0, 0.7)], 0.0).unwrap();
         let b = LocalPoly::of_polygon(&Polygon::new_box(0.5, 0.3).unwrap());
         let check = |p1: &LocalPoly, p2: &LocalPoly| {
-            let (e4, s4) = max_separation_4x4(p1, p2);
-            let (e8, s8) = max_separation_of::<MAX_POLYGON_VERTICES>(p1, p2);
-            assert_eq!(
-                (e4, s4.to_bits()),
-                (e8, s8.to_bits()),
-                "{:?} vs {:?}",
-                (e4, s4),
-                (e8, s8)
-            );
+            same_separation(max_separation_4x4(p1, p2), p1, p2, "4x4");
         };
         for _ in 0..200 {
             let xf = Transform::new(Vec2::new(2.0 * next() - 1.0, 2.0 * next() - 1.0), 6.3 * next());
@@ -457,11 +455,7 @@ mod tests {
     /// random convex polygons (the hull of points on a circle) at random poses.
     #[test]
     fn lane_separations_match_the_scalar_reference() {
-        let mut seed = 777u32;
-        let mut next = move || {
-            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (seed >> 8) as f32 / (1u32 << 24) as f32
-        };
+        let mut next = uniform(777);
         let polygon = |count: usize, xf: Transform, next: &mut dyn FnMut() -> f32| -> LocalPoly {
             if count == 2 {
                 return LocalPoly::from_segment(xf.p, xf.apply(Vec2::new(0.3 + next(), 0.2)), 0.05);
@@ -491,15 +485,7 @@ mod tests {
                         for slot in &mut p2.v[c2..] {
                             *slot = Vec2::new(corner.0, corner.1) * 1.0e6;
                         }
-                        let (e, s) = max_separation(&p1, &p2);
-                        let (er, sr) = max_separation_of::<MAX_POLYGON_VERTICES>(&p1, &p2);
-                        assert_eq!(
-                            (e, s.to_bits()),
-                            (er, sr.to_bits()),
-                            "{c1} vs {c2}: {:?} vs {:?}",
-                            (e, s),
-                            (er, sr)
-                        );
+                        same_separation(max_separation(&p1, &p2), &p1, &p2, &format!("{c1} vs {c2}"));
                     }
                 }
             }

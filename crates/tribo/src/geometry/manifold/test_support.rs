@@ -4,6 +4,15 @@ use super::{collide, Manifold};
 use crate::geometry::{Capsule, Circle, Polygon, Segment, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Transform, Vec2};
 
+/// A reproducible stream of numbers in [0, 1) for randomised fixtures (a linear
+/// congruential generator, Numerical Recipes' constants, its top 24 bits).
+pub(crate) fn uniform(mut seed: u32) -> impl FnMut() -> f32 {
+    move || {
+        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (seed >> 8) as f32 / (1u32 << 24) as f32
+    }
+}
+
 /// Asserts `|a − b| < tol`.
 pub(crate) fn assert_near_v(a: Vec2, b: Vec2, tol: f32) {
     assert!((a - b).length() < tol, "{a:?} vs {b:?} (tol {tol})");
