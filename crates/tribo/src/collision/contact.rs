@@ -107,6 +107,11 @@ pub(crate) struct Contact {
     pub shape_b: ShapeId,
     /// What the last full collision left for the next steps to skip one.
     pub memo: Memo,
+    /// This contact's place in body A's and body B's contact lists (`Body::contacts`), so
+    /// that destroying it takes it out of each list in one step: a static body holds
+    /// thousands (the spinner's ring, the washer's drum), and finding the contact by a
+    /// search was 3.5 % of the spinner's instructions.
+    pub list_pos: [u32; 2],
 }
 
 const _: () = assert!(core::mem::size_of::<Contact>() == 320);
@@ -391,6 +396,7 @@ pub(crate) fn blank_contact() -> Contact {
         manifold: Manifold::default(),
         points: [PointState::default(); MAX_MANIFOLD_POINTS],
         material: MixedMaterial::default(),
+        list_pos: [0; 2],
         rolling_radius: 0.0,
         rolling_impulse: 0.0,
         touching: false,

@@ -1208,12 +1208,32 @@ impl World {
         self.broad_phase
             .pairs
             .remove(&crate::collision::contact::pair_key(c.shape_a.index, c.shape_b.index));
-        for bi in [c.body_a, c.body_b] {
+        for (side, bi) in [(0, c.body_a), (1, c.body_b)] {
             // Only the contact lists, which no solver entry reads (`World::next_entries`).
-            if let Some(b) = self.bodies.at_mut_quiet(bi) {
-                if let Some(pos) = b.contacts.iter().position(|&x| x == ci) {
-                    b.contacts.swap_remove(pos);
-                    b.contact_keys.swap_remove(pos);
+            let Some(b) = self.bodies.at_mut_quiet(bi) else {
+                continue;
+            };
+            // Where the contact says it is (a search only if the list disagrees).
+            let at = c.list_pos[side] as usize;
+            let Some(pos) = Some(at)
+                .filter(|&at| b.contacts.get(at) == Some(&ci))
+                .or_else(|| b.contacts.iter().position(|&x| x == ci))
+            else {
+                continue;
+            };
+            let last = b.contacts.len() - 1;
+            b.contacts.swap_remove(pos);
+            b.contact_keys.swap_remove(pos);
+            // The list's last contact moved into the gap: its record learns its new place.
+            if let Some(Some(m)) = b
+                .contacts
+                .get(pos)
+                .and_then(|&moved| self.contacts.get_mut(moved as usize))
+            {
+                for (k, body) in [m.body_a, m.body_b].into_iter().enumerate() {
+                    if body == bi && m.list_pos[k] as usize == last {
+                        m.list_pos[k] = pos as u32;
+                    }
                 }
             }
         }
@@ -1436,6 +1456,78 @@ mod tests {
         permute_live(&mut got, &new_of_old, expected.len() as u32);
         assert_eq!(got, expected);
         assert!(expected.len() < n && got.iter().all(Option::is_some));
+    }
+
+    /// Every contact knows its place in its two bodies' contact lists (`Contact::list_pos`,
+    /// which `destroy_contact` takes it out by) while pairs come and go: boxes thrown across
+    /// a ground slab and each other, with bodies and shapes destroyed on the way. After every
+    /// step each list holds exactly the contacts of its body, each where its record says.
+    #[test]
+    fn contacts_know_their_place_in_the_body_lists() {
+        let (mut w, ground) = sleepless_with_ground();
+        let slab = Shape::Polygon(Polygon::new_box(30.0, 1.0).unwrap());
+        w.create_shape(ground, &ShapeDef::default(), &slab).unwrap();
+        // Spread velocities: 37 k mod 101 walks all of 0 … 100.
+        let spread = |k: usize| (k * 37 % 101) as f32 / 101.0;
+        let mut boxes = Vec::new();
+        for k in 0..150 {
+            let def = BodyDef {
+                linear_velocity: Vec2::new(12.0 * spread(k) - 6.0, 4.0 * spread(k + 50)),
+                ..BodyDef::dynamic(Vec2::new(0.3 * (k % 30) as f32 - 4.5, 0.2 + 0.25 * (k / 30) as f32))
+            };
+            let b = w.create_body(&def).unwrap();
+            let shape = w.create_shape(b, &ShapeDef::default(), &square()).unwrap();
+            boxes.push((b, shape));
+        }
+        let check = |w: &World| {
+            let mut count = std::collections::HashMap::new();
+            for (ci, c) in w.contacts.iter().enumerate() {
+                let Some(c) = c else { continue };
+                for (side, bi) in [c.body_a, c.body_b].into_iter().enumerate() {
+                    let list = &w.bodies.at(bi).unwrap().contacts;
+                    assert_eq!(
+                        list.get(c.list_pos[side] as usize),
+                        Some(&(ci as u32)),
+                        "contact {ci}, side {side}"
+                    );
+                    *count.entry(bi).or_insert(0usize) += 1;
+                }
+            }
+            for (bi, b) in w.bodies.iter() {
+                assert_eq!(b.contacts.len(), count.get(&bi).copied().unwrap_or(0), "body {bi}");
+                assert_eq!(b.contacts.len(), b.contact_keys.len());
+            }
+        };
+        let mut destroyed = 0;
+        // Ground pairs destroyed (a contact index that left the slab's list, from the
+        // middle of the list as often as not), and the longest the list was.
+        let (mut left_ground, mut longest) = (0, 0);
+        let ground_list = |w: &World| w.bodies.at(ground.index).unwrap().contacts.clone();
+        for step in 0..150 {
+            let before = ground_list(&w);
+            w.step(1.0 / 60.0).unwrap();
+            check(&w);
+            longest = longest.max(before.len());
+            if step % 10 == 5 {
+                // A box of the bottom row (the first 30): its pair with the slab goes.
+                let (b, shape) = boxes[(step / 10) * 2];
+                if step % 20 == 5 {
+                    w.destroy_shape(shape).ok();
+                } else {
+                    w.destroy_body(b).ok();
+                }
+                destroyed += 1;
+                check(&w);
+                let after = ground_list(&w);
+                left_ground += before.iter().filter(|ci| !after.contains(ci)).count();
+            }
+        }
+        let live = w.contacts.iter().flatten().count();
+        assert!(destroyed > 0 && live > 100, "{live} contacts at the end");
+        assert!(
+            longest >= 30 && left_ground >= 10,
+            "slab list up to {longest}, {left_ground} left it"
+        );
     }
 
     /// Renumbering the contacts in the solver's layout order (`World::reorder_contacts`)

@@ -316,6 +316,7 @@ impl World {
             touching: false,
             colour: NO_COLOUR,
             memo: Memo::None,
+            list_pos: [a.body.index, b.body.index].map(|bi| self.bodies.at(bi).map_or(0, |b| b.contacts.len() as u32)),
         };
         let (body_a, body_b) = (contact.body_a, contact.body_b);
         let ci = match self.contact_free.pop() {
