@@ -1215,10 +1215,10 @@ impl World {
             };
             // Where the contact says it is (a search only if the list disagrees).
             let at = c.list_pos[side] as usize;
-            let Some(pos) = Some(at)
-                .filter(|&at| b.contacts.get(at) == Some(&ci))
-                .or_else(|| b.contacts.iter().position(|&x| x == ci))
-            else {
+            let Some(pos) = Some(at).filter(|&at| b.contacts.get(at) == Some(&ci)).or_else(|| {
+                debug_assert!(false, "contact {ci} is not where its record says in body {bi}'s list");
+                b.contacts.iter().position(|&x| x == ci)
+            }) else {
                 continue;
             };
             let last = b.contacts.len() - 1;
@@ -1458,6 +1458,27 @@ mod tests {
         assert!(expected.len() < n && got.iter().all(Option::is_some));
     }
 
+    /// Asserts that each body's contact list holds exactly its contacts, each where its
+    /// record says (`Contact::list_pos`), with the pair key of its shapes beside it.
+    fn check_contact_lists(w: &World) {
+        let mut count = std::collections::HashMap::new();
+        for (ci, c) in w.contacts.iter().enumerate() {
+            let Some(c) = c else { continue };
+            for (side, bi) in [c.body_a, c.body_b].into_iter().enumerate() {
+                let b = w.bodies.at(bi).unwrap();
+                let at = c.list_pos[side] as usize;
+                assert_eq!(b.contacts.get(at), Some(&(ci as u32)), "contact {ci}, side {side}");
+                let key = crate::collision::contact::pair_key(c.shape_a.index, c.shape_b.index);
+                assert_eq!(b.contact_keys.get(at), Some(&key), "contact {ci}'s key");
+                *count.entry(bi).or_insert(0usize) += 1;
+            }
+        }
+        for (bi, b) in w.bodies.iter() {
+            assert_eq!(b.contacts.len(), count.get(&bi).copied().unwrap_or(0), "body {bi}");
+            assert_eq!(b.contacts.len(), b.contact_keys.len());
+        }
+    }
+
     /// Every contact knows its place in its two bodies' contact lists (`Contact::list_pos`,
     /// which `destroy_contact` takes it out by) while pairs come and go: boxes thrown across
     /// a ground slab and each other, with bodies and shapes destroyed on the way. After every
@@ -1479,25 +1500,7 @@ mod tests {
             let shape = w.create_shape(b, &ShapeDef::default(), &square()).unwrap();
             boxes.push((b, shape));
         }
-        let check = |w: &World| {
-            let mut count = std::collections::HashMap::new();
-            for (ci, c) in w.contacts.iter().enumerate() {
-                let Some(c) = c else { continue };
-                for (side, bi) in [c.body_a, c.body_b].into_iter().enumerate() {
-                    let list = &w.bodies.at(bi).unwrap().contacts;
-                    assert_eq!(
-                        list.get(c.list_pos[side] as usize),
-                        Some(&(ci as u32)),
-                        "contact {ci}, side {side}"
-                    );
-                    *count.entry(bi).or_insert(0usize) += 1;
-                }
-            }
-            for (bi, b) in w.bodies.iter() {
-                assert_eq!(b.contacts.len(), count.get(&bi).copied().unwrap_or(0), "body {bi}");
-                assert_eq!(b.contacts.len(), b.contact_keys.len());
-            }
-        };
+        let check = check_contact_lists;
         let mut destroyed = 0;
         // Ground pairs destroyed (a contact index that left the slab's list, from the
         // middle of the list as often as not), and the longest the list was.
@@ -1568,6 +1571,8 @@ mod tests {
             assert_eq!((x.xf, x.v, x.w), (y.xf, y.v, y.w));
         }
         assert!(start - top(&a) < 0.01, "top box sank {} m", start - top(&a));
+        // The bodies' contact lists follow the renumbering.
+        check_contact_lists(&a);
     }
 
     /// Keeping last step's colours and layout when the candidates are unchanged
