@@ -238,7 +238,7 @@ pub(crate) struct ContactSolver {
     head: Vec<WideHead>,
     wide: Vec<WideContact>,
     cold: Vec<WideCold>,
-    /// Per group: what the passes read ready-made ([`contact_wide::derive`]).
+    /// Per group: what the passes read ready-made ([`contact_wide::WideDerived::new`]).
     derived: Vec<WideDerived>,
     /// Constraints that found no colour, whole (solved first in each pass).
     overflow: Vec<ContactConstraint>,

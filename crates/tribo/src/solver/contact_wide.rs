@@ -216,7 +216,7 @@ pub(crate) struct WideCold {
 }
 
 /// What every pass of a step would derive again from a group's [`WideHead`] and
-/// [`WideContact`], made once a step ([`derive`]) and kept in an array of its own: the
+/// [`WideContact`], made once a step ([`WideDerived::new`]) and kept in an array of its own: the
 /// friction row's anchors [m] and K⁻¹ = [k22, −k12; −k12, k11] / det K (zero where the
 /// block does not apply). Only the passes read it; the build writes it and the store does
 /// not touch it, so neither streams it with the groups. (Kept inside [`WideContact`] it
@@ -231,16 +231,9 @@ pub(crate) struct WideDerived {
     pub i22: F4,
 }
 
-/// The group's [`WideDerived`]: the expressions the passes evaluated each time, so the
-/// same bits.
-#[inline(always)]
-pub(crate) fn derive(h: &WideHead, w: &WideContact) -> WideDerived {
-    WideDerived::new(friction_arms(h), w)
-}
-
 impl WideDerived {
     /// From the group's friction anchors `(fr_a, fr_b)` ([`friction_arms`]) and its K and
-    /// 1/det K.
+    /// 1/det K: the expressions the passes evaluated each time, so the same bits.
     #[inline(always)]
     fn new((fr_a, fr_b): (V4, V4), w: &WideContact) -> WideDerived {
         WideDerived {
@@ -1290,7 +1283,7 @@ pub(crate) fn pack(
     w.mu[l] = if stick { cc.mu_s } else { cc.mu_d };
     h.two_points[l] = if cc.count == 2 { u32::MAX } else { 0 };
     pack_state(h, w, l, cc);
-    *derived = derive(h, w);
+    *derived = WideDerived::new(friction_arms(h), w);
 }
 
 /// Copies the parts of a constraint that change during the substeps into lane `l`.

@@ -1022,10 +1022,7 @@ impl World {
             let Some(s) = self.shapes.at_mut(index) else {
                 continue;
             };
-            let tight = match known.filter(|_| k == first) {
-                Some(tight) => tight,
-                None => s.geometry.aabb(xf),
-            };
+            let tight = known.filter(|_| k == first).unwrap_or_else(|| s.geometry.aabb(xf));
             let Some(aabb) = next_box(s, tight, v, dt, check, sweep, moved) else {
                 return Some((k, tight));
             };
@@ -1296,9 +1293,9 @@ pub(crate) fn box_velocity(b: &Body, limit: f32) -> Vec2 {
     }
 }
 
-/// A shape's box for the next step from `tight`, its box at the body's new pose (swept along `v` for `dt` when
-/// `sweep`, see [`sweep_free`]), or `None` when `check` finds that the body must first be
-/// checked against static shapes ([`World::stop_at_static_shapes`]):
+/// A shape's box for the next step from `tight`, its box at the body's new pose (swept
+/// along `v` for `dt` when `sweep`, see [`sweep_free`]), or `None` when `check` finds that
+/// the body must first be checked against static shapes ([`World::stop_at_static_shapes`]):
 /// - the shape escaped: a static shape the body has no pair with had its fat box (its box
 ///   grown by the speculative distance) apart from this one's, so a shape poking out of its
 ///   fat box by less than the speculative distance plus the slop overlaps it by the slop at
@@ -1500,7 +1497,6 @@ mod tests {
             let shape = w.create_shape(b, &ShapeDef::default(), &square()).unwrap();
             boxes.push((b, shape));
         }
-        let check = check_contact_lists;
         let mut destroyed = 0;
         // Ground pairs destroyed (a contact index that left the slab's list, from the
         // middle of the list as often as not), and the longest the list was.
@@ -1509,7 +1505,7 @@ mod tests {
         for step in 0..150 {
             let before = ground_list(&w);
             w.step(1.0 / 60.0).unwrap();
-            check(&w);
+            check_contact_lists(&w);
             longest = longest.max(before.len());
             if step % 10 == 5 {
                 // A box of the bottom row (the first 30): its pair with the slab goes.
@@ -1520,7 +1516,7 @@ mod tests {
                     w.destroy_body(b).ok();
                 }
                 destroyed += 1;
-                check(&w);
+                check_contact_lists(&w);
                 let after = ground_list(&w);
                 left_ground += before.iter().filter(|ci| !after.contains(ci)).count();
             }

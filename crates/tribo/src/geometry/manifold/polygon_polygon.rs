@@ -26,7 +26,7 @@ use super::{
     KIND_CLIP_REF_B, KIND_VERTEX_VERTEX,
 };
 use crate::geometry::{Polygon, LINEAR_SLOP, MAX_POLYGON_VERTICES};
-use crate::math::wide::{join_xy, split_xy, transpose, F4};
+use crate::math::wide::{apply_lanes, join_xy, split_xy, transpose, F4};
 use crate::math::{Transform, Vec2};
 
 /// How much better [m] the other face must be before a pair whose last manifold clipped
@@ -66,18 +66,18 @@ impl LocalPoly {
     pub fn from_polygon(p: &Polygon, xf: Transform) -> LocalPoly {
         let count = p.count();
         let (c, s) = (F4::splat(xf.q.c), F4::splat(xf.q.s));
-        let (tx, ty) = (F4::splat(xf.p.x), F4::splat(xf.p.y));
-        // Four slots at a time, each lane `Rot::rotate` (and `Transform::apply`) in its
-        // order: the scalar bits.
-        // (`first` is 0 or 4; the modulo only spares the bounds checks.)
+        let t = (F4::splat(xf.p.x), F4::splat(xf.p.y));
+        // Four slots at a time, each lane `Transform::apply` (vertices, `apply_lanes`) or
+        // `Rot::rotate` (normals) in its order: the scalar bits. (`first` is 0 or 4; the
+        // modulo only spares the bounds checks.)
         let moved = |q: &[Vec2; MAX_POLYGON_VERTICES], first: usize, shift: bool| {
             let (x, y) = split_xy(core::array::from_fn(|k| q[(first + k) % MAX_POLYGON_VERTICES]));
-            let (rx, ry) = (c * x - s * y, s * x + c * y);
-            if shift {
-                join_xy(rx + tx, ry + ty)
+            let (mx, my) = if shift {
+                apply_lanes((c, s), t, (x, y))
             } else {
-                join_xy(rx, ry)
-            }
+                (c * x - s * y, s * x + c * y)
+            };
+            join_xy(mx, my)
         };
         let (v, n) = (&p.vertices, &p.normals);
         let z = [Vec2::ZERO; 4];
