@@ -768,6 +768,18 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     scatter(states, &h.index_b, &h.write_b, &b);
 }
 
+/// What an empty lane of the build reads as its bodies: static ones (zeros).
+const NO_BODIES: ConstraintBodies = ConstraintBodies {
+    index_a: 0,
+    index_b: 0,
+    inv_mass_a: 0.0,
+    inv_i_a: 0.0,
+    inv_mass_b: 0.0,
+    inv_i_b: 0.0,
+    center_a: Vec2::ZERO,
+    center_b: Vec2::ZERO,
+};
+
 /// One lane's constraint to build: its contact index, solver input and bodies.
 pub(crate) type LaneInput<'a> = Option<(u32, &'a ContactInput, &'a ConstraintBodies)>;
 
@@ -802,28 +814,30 @@ pub(crate) fn build_group<S: StateRead>(
     // scalar stores it spans and waited for every store before it to drain, the group's
     // clearing included: a fifth of the build's samples; the build and its `memset`s went
     // from 11.2 % to 10.7 % of large_pyramid's step.
+    //
+    // An empty lane reads an empty input and static bodies (all zeros, as if the lane
+    // were skipped) instead of being tested at every column: large_pyramid's build ran
+    // 8 % fewer instructions (1 298 → 1 195 a group). Only the tangent impulse of an
+    // empty input differs (−0.0), so it is masked.
+    let read: [(&ContactInput, &ConstraintBodies); LANES] =
+        lanes.map(|lane| lane.map_or((&ContactInput::EMPTY, &NO_BODIES), |(_, input, b)| (input, b)));
+    let present = M4::from_bools(lanes.map(|lane| lane.is_some()));
     let each = |f: &dyn Fn(&ContactInput, &ConstraintBodies) -> f32| {
-        F4::new(core::array::from_fn(|l| {
-            lanes[l].map_or(0.0, |(_, input, b)| f(input, b))
-        }))
+        F4::new(core::array::from_fn(|l| f(read[l].0, read[l].1)))
     };
     let count_of = |input: &ContactInput| input.count.min(2);
     // Fields that lie side by side in a candidate come as one 16-byte row per lane,
     // transposed into four lanes of each (zeros in an empty lane): eight shuffles instead
     // of sixteen single-lane loads and inserts per row.
     let columns = |row: &dyn Fn(&ContactInput, &ConstraintBodies) -> [f32; LANES]| {
-        transpose(core::array::from_fn(|l| {
-            F4::new(lanes[l].map_or([0.0; LANES], |(_, input, b)| row(input, b)))
-        }))
+        transpose(core::array::from_fn(|l| F4::new(row(read[l].0, read[l].1))))
     };
     let [cax, cay, cbx, cby] = columns(&|_, b| b.centre_row());
     let (center_a, center_b) = (V4 { x: cax, y: cay }, V4 { x: cbx, y: cby });
     let [ma, ia, mb, ib] = columns(&|_, b| b.mass_row());
     // Each point's (x, y, separation, normal impulse); kept where the lane has the point.
     let point_rows: [[F4; 4]; 2] = core::array::from_fn(|i| columns(&|input, _| input.points[i].row()));
-    let has: [M4; 2] = core::array::from_fn(|i| {
-        M4::from_bools(lanes.map(|lane| lane.is_some_and(|(_, input, _)| i < count_of(input))))
-    });
+    let has: [M4; 2] = core::array::from_fn(|i| M4::from_bools(read.map(|(input, _)| i < count_of(input))));
     let point: [V4; 2] = core::array::from_fn(|i| V4 {
         x: has[i].select(point_rows[i][0], zero),
         y: has[i].select(point_rows[i][1], zero),
@@ -851,14 +865,17 @@ pub(crate) fn build_group<S: StateRead>(
     }
     // Summed as `pack_state` sums (`Iterator::sum` of f32 starts at −0.0, and −0.0 + x is
     // x: the same bits, the same sign of a zero sum), without a loop; +0.0 in an empty lane.
-    hd.tangent_impulse = each(&|input, _| {
-        let t = |i: usize| if warm { input.points[i].tangent_impulse } else { 0.0 };
-        match count_of(input) {
-            0 => -0.0,
-            1 => t(0),
-            _ => t(0) + t(1),
-        }
-    });
+    hd.tangent_impulse = present.select(
+        each(&|input, _| {
+            let t = |i: usize| if warm { input.points[i].tangent_impulse } else { 0.0 };
+            match count_of(input) {
+                0 => -0.0,
+                1 => t(0),
+                _ => t(0) + t(1),
+            }
+        }),
+        zero,
+    );
     c.base_drift = base_drift.map(|d| *d);
     let [mu_s, mu_d, restitution, threshold] = columns(&|input, _| input.material_row());
     (c.mu_s, c.mu_d, c.restitution, c.restitution_threshold) = (*mu_s, *mu_d, *restitution, *threshold);
@@ -1596,6 +1613,30 @@ mod tests {
             (0.0, 0.0, 0.0)
         );
         assert!(h.any_rolling && cold.any_restitution && w.block.lane(0));
+        // The empty lane reads as zeros everywhere, +0.0 to the bit (an empty input's
+        // tangent impulse, a sum over no points, would be −0.0).
+        let p = |i: usize| {
+            [
+                h.points[i].r_a.x,
+                h.points[i].r_b.y,
+                h.points[i].normal_impulse,
+                w.points[i].base_separation,
+            ]
+        };
+        let empty = [
+            [
+                h.normal.x,
+                h.normal.y,
+                h.inv_mass_a,
+                h.inv_i_b,
+                h.tangent_impulse,
+                h.rolling_impulse,
+                w.mu,
+                w.tangent_mass,
+            ],
+            [p(0), p(1)].concat().try_into().unwrap_or([F4::splat(1.0); 8]),
+        ];
+        assert!(empty.iter().flatten().all(|x| x[3].to_bits() == 0), "{empty:?}");
     }
 
     /// The group's flags are set from its lanes' columns: none without restitution or a
