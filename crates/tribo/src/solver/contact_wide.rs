@@ -102,70 +102,6 @@ pub(crate) struct WideHead {
     pub rolling_impulse: F4,
 }
 
-impl WideHead {
-    /// Every field to zero, written in place field by field: `*self = WideHead::default()`
-    /// was compiled as a zeroed copy on the stack and a 400-byte `memcpy` (1.3 % of
-    /// large_pyramid's step in `perf`); this is one `memset` into the group. The build
-    /// and its `memcpy`/`memset` went from 8.2 % of the step's samples to 7.2–7.5 %.
-    /// The fields are named exhaustively (no `..`), so a field added to the struct is a
-    /// compile error here rather than one left uncleared.
-    #[inline(always)]
-    fn clear(&mut self) {
-        let (z, v) = (F4::ZERO, V4::default());
-        let WideHead {
-            index_a,
-            index_b,
-            write_a,
-            write_b,
-            any_rolling,
-            any_restitution,
-            normal,
-            inv_mass_a,
-            inv_i_a,
-            inv_mass_b,
-            inv_i_b,
-            split,
-            shift_cap2,
-            points,
-            tangent_impulse,
-            two_points,
-            rolling_impulse,
-        } = self;
-        *index_a = [0; LANES];
-        *index_b = [0; LANES];
-        *write_a = [false; LANES];
-        *write_b = [false; LANES];
-        *any_rolling = false;
-        *any_restitution = false;
-        *normal = v;
-        for x in [
-            inv_mass_a,
-            inv_i_a,
-            inv_mass_b,
-            inv_i_b,
-            split,
-            shift_cap2,
-            tangent_impulse,
-            rolling_impulse,
-        ] {
-            *x = z;
-        }
-        for p in points.iter_mut() {
-            let HeadPoint {
-                r_a,
-                r_b,
-                normal_impulse,
-                substep_vn,
-            } = p;
-            *r_a = v;
-            *r_b = v;
-            *normal_impulse = z;
-            *substep_vn = z;
-        }
-        *two_points = M4::default();
-    }
-}
-
 /// The rest of four contact constraints, one per lane (see the module docs): what only
 /// the solve passes read.
 ///
@@ -803,9 +739,10 @@ pub(crate) fn build_group<S: StateRead>(
     let zero = F4::ZERO;
     let one = F4::splat(1.0);
     let half = F4::splat(0.5);
-    // Written in place (a 1 KiB group built on the stack and copied costs more).
-    head.clear();
-    *w = WideContact::default();
+    // Written in place (a 1 KiB group built on the stack and copied costs more), every
+    // field of `head` and `w` once, with no clearing first: clearing them was two
+    // `memset` calls a group, 84 instructions of large_pyramid's ~1 200 (the test
+    // `build_writes_every_field` builds into a poisoned group). `cold` is cleared.
     *cold = WideCold::default();
     let (hd, out, c) = (head, w, cold);
     // What the four-lane part below reads, assembled from the candidates in registers
@@ -822,6 +759,11 @@ pub(crate) fn build_group<S: StateRead>(
     let read: [(&ContactInput, &ConstraintBodies); LANES] =
         lanes.map(|lane| lane.map_or((&ContactInput::EMPTY, &NO_BODIES), |(_, input, b)| (input, b)));
     let present = M4::from_bools(lanes.map(|lane| lane.is_some()));
+    // Each lane's bodies (an empty lane: the static body, not written back).
+    hd.index_a = read.map(|(_, b)| b.index_a);
+    hd.index_b = read.map(|(_, b)| b.index_b);
+    hd.write_a = read.map(|(_, b)| (b.inv_mass_a > 0.0 || b.inv_i_a > 0.0) && b.index_a != 0);
+    hd.write_b = read.map(|(_, b)| (b.inv_mass_b > 0.0 || b.inv_i_b > 0.0) && b.index_b != 0);
     let each = |f: &dyn Fn(&ContactInput, &ConstraintBodies) -> f32| {
         F4::new(core::array::from_fn(|l| f(read[l].0, read[l].1)))
     };
@@ -858,11 +800,29 @@ pub(crate) fn build_group<S: StateRead>(
     };
     (hd.inv_mass_a, hd.inv_i_a, hd.inv_mass_b, hd.inv_i_b) = (ma, ia, mb, ib);
     for i in 0..2 {
-        out.points[i].base_separation = has[i].select(point_rows[i][2], zero);
-        if warm {
-            hd.points[i].normal_impulse = has[i].select(point_rows[i][3], zero);
-        }
+        let (hp, wp) = (&mut hd.points[i], &mut out.points[i]);
+        wp.base_separation = has[i].select(point_rows[i][2], zero);
+        hp.normal_impulse = if warm {
+            has[i].select(point_rows[i][3], zero)
+        } else {
+            zero
+        };
+        wp.preload = each(&|input, _| {
+            if warm && i < count_of(input) {
+                input.points[i].preload
+            } else {
+                0.0
+            }
+        });
+        // The step's sums and what restitution tracks start from zero.
+        (
+            hp.substep_vn,
+            wp.total_normal_impulse,
+            wp.max_normal_impulse,
+            wp.approach,
+        ) = (zero, zero, zero, zero);
     }
+    (out.total_tangent_impulse, out.saturated) = (zero, M4::default());
     // Summed as `pack_state` sums (`Iterator::sum` of f32 starts at −0.0, and −0.0 + x is
     // x: the same bits, the same sign of a zero sum), without a loop; +0.0 in an empty lane.
     hd.tangent_impulse = present.select(
@@ -881,9 +841,7 @@ pub(crate) fn build_group<S: StateRead>(
     (c.mu_s, c.mu_d, c.restitution, c.restitution_threshold) = (*mu_s, *mu_d, *restitution, *threshold);
     let [rolling_resistance, tangent_speed, rolling_impulse, _] = columns(&|input, _| input.surface_row());
     (out.rolling_resistance, out.tangent_speed) = (rolling_resistance, tangent_speed);
-    if warm {
-        hd.rolling_impulse = rolling_impulse;
-    }
+    hd.rolling_impulse = if warm { rolling_impulse } else { zero };
     // The group's flags and the points' heights, four lanes at once from the columns (an
     // empty lane's zeros set no flag and give the height 0): the scalar tests and the
     // height's `dot`, lane by lane.
@@ -902,10 +860,6 @@ pub(crate) fn build_group<S: StateRead>(
         let count = count_of(input);
         c.contact[l] = contact;
         c.count[l] = count as u8;
-        hd.index_a[l] = b.index_a;
-        hd.index_b[l] = b.index_b;
-        hd.write_a[l] = (b.inv_mass_a > 0.0 || b.inv_i_a > 0.0) && b.index_a != 0;
-        hd.write_b[l] = (b.inv_mass_b > 0.0 || b.inv_i_b > 0.0) && b.index_b != 0;
         let states_ab = input.points[..count]
             .iter()
             .any(|p| p.fresh)
@@ -917,10 +871,6 @@ pub(crate) fn build_group<S: StateRead>(
         let t = input.normal.right_perp();
         let mut row_stick = true;
         for (i, ip) in input.points[..count].iter().enumerate() {
-            let wp = &mut out.points[i];
-            if warm {
-                wp.preload[l] = ip.preload;
-            }
             let stick = match states_ab {
                 Some((sa, sb)) if ip.fresh => {
                     let (r_a, r_b) = (ip.point - b.center_a, ip.point - b.center_b);
@@ -1637,6 +1587,43 @@ mod tests {
             [p(0), p(1)].concat().try_into().unwrap_or([F4::splat(1.0); 8]),
         ];
         assert!(empty.iter().flatten().all(|x| x[3].to_bits() == 0), "{empty:?}");
+    }
+
+    /// The build writes every field of the group's `WideHead` and `WideContact` (it no
+    /// longer clears them first): built into records whose every byte is 0x01 (a valid
+    /// `true`, a nonzero float and mask), the group comes out as built into zeroed ones,
+    /// with and without warm starting (whose fields it writes either way).
+    #[test]
+    #[allow(unsafe_code)]
+    fn build_writes_every_field() {
+        let f = fixture();
+        for warm in [true, false] {
+            let ctx = StepContext {
+                warm_starting: warm,
+                ..f.ctx
+            };
+            let clean = built(f.lanes(), f.up, &ctx, &f.states);
+            let (mut h, mut w, mut cold, mut dv) = built(f.lanes(), f.up, &ctx, &f.states);
+            // SAFETY: every field of both records (u32, bool, f32 lanes, masks) is valid
+            // for the byte 0x01 (bool: true).
+            unsafe {
+                core::ptr::write_bytes(&mut h as *mut WideHead, 0x01, 1);
+                core::ptr::write_bytes(&mut w as *mut WideContact, 0x01, 1);
+            }
+            assert!(h.write_a[3] && w.approach_is_poisoned(), "poisoned");
+            build_group(&mut h, &mut w, &mut cold, &mut dv, f.lanes(), f.up, &ctx, &f.states);
+            assert_eq!(
+                format!("{:?}", (clean.0, clean.1)),
+                format!("{:?}", (h, w)),
+                "warm {warm}"
+            );
+        }
+    }
+
+    impl WideContact {
+        fn approach_is_poisoned(&self) -> bool {
+            self.points[1].approach[0].to_bits() == 0x0101_0101
+        }
     }
 
     /// The group's flags are set from its lanes' columns: none without restitution or a
