@@ -210,6 +210,7 @@ mod sse {
         _mm_castsi128_ps(a: __m128i) -> __m128;
         _mm_cmpeq_epi32(a: __m128i, b: __m128i) -> __m128i;
         _mm_or_si128(a: __m128i, b: __m128i) -> __m128i;
+        _mm_and_si128(a: __m128i, b: __m128i) -> __m128i;
         _mm_setzero_si128() -> __m128i;
         _mm_castps_si128(a: __m128) -> __m128i;
         _mm_add_ps(a: __m128, b: __m128) -> __m128;
@@ -506,6 +507,41 @@ impl M4 {
         M4::new(b.map(mask))
     }
 
+    /// [`M4::from_bools`] for four booleans stored side by side in a record: on x86-64 the
+    /// four bytes loaded as one word into every lane, each lane testing its own byte (four
+    /// instructions, where building the lanes one by one took about fifteen; booleans just
+    /// computed are better made into lanes directly, by `from_bools`).
+    #[inline(always)]
+    pub fn from_stored_bools(b: [bool; LANES]) -> M4 {
+        simd!(
+            {
+                // Lane l holds bit 0 of byte l of the word (a bool's byte is 0 or 1).
+                let word = i32::from_le_bytes(b.map(u8::from));
+                let bits = _mm_setr_epi32(1, 1 << 8, 1 << 16, 1 << 24);
+                sse::to_m(_mm_castsi128_ps(_mm_cmpeq_epi32(
+                    _mm_and_si128(_mm_set1_epi32(word), bits),
+                    bits,
+                )))
+            },
+            M4::new(b.map(mask))
+        )
+    }
+
+    /// The lanes whose byte in `b` is not zero (as [`M4::from_stored_bools`], one
+    /// instruction more).
+    #[inline(always)]
+    pub fn from_nonzero_bytes(b: [u8; LANES]) -> M4 {
+        simd!(
+            {
+                let word = i32::from_le_bytes(b);
+                let bytes = _mm_setr_epi32(0xFF, 0xFF << 8, 0xFF << 16, 0xFF << 24);
+                let zero = _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(word), bytes), _mm_setzero_si128());
+                !sse::to_m(_mm_castsi128_ps(zero))
+            },
+            M4::new(b.map(|x| mask(x != 0)))
+        )
+    }
+
     /// The lanes where `a` or `b` is zero.
     #[inline(always)]
     pub fn either_zero(a: [u32; LANES], b: [u32; LANES]) -> M4 {
@@ -705,6 +741,35 @@ impl Sub for V4 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Each lane of `from_stored_bools` (and `from_bools`) is set exactly where its boolean
+    /// is true, for all sixteen patterns, and `from_nonzero_bytes` exactly where its byte is
+    /// not zero (each byte value in each lane, so a bit of one byte cannot leak into another
+    /// lane).
+    #[test]
+    fn masks_from_bytes_set_exactly_their_lanes() {
+        let lanes = |m: M4| core::array::from_fn::<bool, LANES, _>(|l| m.lane(l));
+        for pattern in 0..16u32 {
+            let b: [bool; LANES] = core::array::from_fn(|l| pattern >> l & 1 == 1);
+            let all = b.map(|x| if x { u32::MAX } else { 0 });
+            assert_eq!(lanes(M4::from_stored_bools(b)), b, "{b:?}");
+            assert_eq!((*M4::from_stored_bools(b), *M4::from_bools(b)), (all, all));
+        }
+        for x in 0..=255u8 {
+            for l in 0..LANES {
+                let mut bytes = [0u8; LANES];
+                bytes[l] = x;
+                let expected: [bool; LANES] = core::array::from_fn(|k| k == l && x != 0);
+                assert_eq!(lanes(M4::from_nonzero_bytes(bytes)), expected, "{bytes:?}");
+                // The other lanes full: only lane l depends on x.
+                let others = bytes.map(|b| if b == 0 { 7 } else { b });
+                let mut full = others;
+                full[l] = x;
+                let expected: [bool; LANES] = core::array::from_fn(|k| k != l || x != 0);
+                assert_eq!(lanes(M4::from_nonzero_bytes(full)), expected, "{full:?}");
+            }
+        }
+    }
 
     /// `split_xy` gathers the x and the y of four points, in order, and `join_xy` puts
     /// them back.

@@ -1008,7 +1008,7 @@ pub(crate) fn store_group<S: StateRead>(
     }
     // Four lanes at once; every expression is the scalar store's, in its order.
     let zero = F4::ZERO;
-    let has0 = M4::from_bools(cold.count.map(|c| c >= 1));
+    let has0 = M4::from_nonzero_bytes(cold.count);
     let (two, share) = (h.two_points, tangent_share(h, 0));
     let (tangent, total_tangent) = (share * h.tangent_impulse, share * w.total_tangent_impulse);
     // Sums over the points from 0.0 (the scalar loop's start).
@@ -1034,7 +1034,10 @@ pub(crate) fn store_group<S: StateRead>(
     let point = |i: usize| {
         let (wp, normal) = (&w.points[i], h.points[i].normal_impulse);
         let (total_normal, max) = (wp.total_normal_impulse, wp.max_normal_impulse);
-        let (was_stick, fresh) = (M4::from_bools(cold.stick[i]), M4::from_bools(cold.fresh[i]));
+        let (was_stick, fresh) = (
+            M4::from_stored_bools(cold.stick[i]),
+            M4::from_stored_bools(cold.fresh[i]),
+        );
         let slip_speed = vt[i].abs();
         let loaded = max.gt(zero);
         // Loaded points change state: a sticking one slips when the patch is saturated and
