@@ -527,8 +527,8 @@ impl M4 {
         )
     }
 
-    /// The lanes whose byte in `b` is not zero (as [`M4::from_stored_bools`], one
-    /// instruction more).
+    /// The lanes whose byte in `b` is not zero (as [`M4::from_stored_bools`]: the same
+    /// word, each lane's byte compared with zero and the result negated).
     #[inline(always)]
     pub fn from_nonzero_bytes(b: [u8; LANES]) -> M4 {
         simd!(

@@ -118,16 +118,7 @@ impl Candidate {
     /// A placeholder for a contact that is not solved this step.
     pub const SKIP: Candidate = Candidate {
         contact: u32::MAX,
-        bodies: ConstraintBodies {
-            index_a: 0,
-            index_b: 0,
-            inv_mass_a: 0.0,
-            inv_i_a: 0.0,
-            inv_mass_b: 0.0,
-            inv_i_b: 0.0,
-            center_a: Vec2::ZERO,
-            center_b: Vec2::ZERO,
-        },
+        bodies: ConstraintBodies::STATIC,
         input: ContactInput::EMPTY,
     };
 }
@@ -677,7 +668,7 @@ impl ContactSolver {
                 self.group_colour.resize(groups as usize, k as u8);
             }
         }
-        // Every lane is written whole below (packed or cleared): no memset.
+        // Every lane is written whole below (built, empty lanes too, or packed): no memset.
         self.head.resize(groups as usize, WideHead::default());
         self.head.truncate(groups as usize);
         self.wide.resize(groups as usize, WideContact::default());

@@ -147,6 +147,19 @@ pub(crate) struct ConstraintBodies {
 }
 
 impl ConstraintBodies {
+    /// Two static bodies (slot 0, no mass): an unused slot's bodies. The wide build reads
+    /// these for an empty lane, so every field must stay zero.
+    pub const STATIC: ConstraintBodies = ConstraintBodies {
+        index_a: 0,
+        index_b: 0,
+        inv_mass_a: 0.0,
+        inv_i_a: 0.0,
+        inv_mass_b: 0.0,
+        inv_i_b: 0.0,
+        center_a: Vec2::ZERO,
+        center_b: Vec2::ZERO,
+    };
+
     /// The inverse masses and inertias (A's, then B's), side by side in the record: one
     /// row of the wide build's transpose.
     #[inline(always)]
@@ -215,7 +228,8 @@ impl ContactInput {
         [self.rolling_resistance, self.tangent_speed, self.rolling_impulse, 0.0]
     }
 
-    /// No points, no material.
+    /// No points, no material. The wide build reads it for an empty lane
+    /// (`contact_wide::build_group`), so every float must stay +0.0.
     pub const EMPTY: ContactInput = ContactInput {
         normal: Vec2::ZERO,
         count: 0,

@@ -74,6 +74,10 @@ pub(crate) struct HeadPoint {
 /// The part of four constraints the warm start needs (bodies, normal, masses, anchors,
 /// impulses), kept in its own array: the warm start streams only these ~400 bytes per
 /// group instead of the whole constraint (it is bound by memory traffic, not arithmetic).
+///
+/// [`build_group`] writes every field, with no clearing first (as for [`WideContact`]): a
+/// field added here must be written there, and poisoned in the test `build_writes_every_field`
+/// (which does not compile until it is).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WideHead {
     pub index_a: [u32; LANES],
@@ -110,7 +114,8 @@ pub(crate) struct WideHead {
 /// a side is static), 1/k11 and 1/k22 (the points' normal masses where the block applies)
 /// and the rolling mass (from the inverse inertias) are derived where they are used; K⁻¹
 /// and the friction row's anchors, which every pass would derive, are in the group's
-/// [`WideDerived`]. 400 bytes (was 608).
+/// [`WideDerived`]. 400 bytes (was 608). [`build_group`] writes every field (see
+/// [`WideHead`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WideContact {
     /// Friction coefficient of the row this step: μs where it sticks, μd where it slides.
@@ -704,18 +709,6 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     scatter(states, &h.index_b, &h.write_b, &b);
 }
 
-/// What an empty lane of the build reads as its bodies: static ones (zeros).
-const NO_BODIES: ConstraintBodies = ConstraintBodies {
-    index_a: 0,
-    index_b: 0,
-    inv_mass_a: 0.0,
-    inv_i_a: 0.0,
-    inv_mass_b: 0.0,
-    inv_i_b: 0.0,
-    center_a: Vec2::ZERO,
-    center_b: Vec2::ZERO,
-};
-
 /// One lane's constraint to build: its contact index, solver input and bodies.
 pub(crate) type LaneInput<'a> = Option<(u32, &'a ContactInput, &'a ConstraintBodies)>;
 
@@ -747,17 +740,20 @@ pub(crate) fn build_group<S: StateRead>(
     let (hd, out, c) = (head, w, cold);
     // What the four-lane part below reads, assembled from the candidates in registers
     // (zero in empty lanes and absent points). Stored lane by lane and read back as
-    // vectors, as before, the first vector load could not be forwarded from the four
-    // scalar stores it spans and waited for every store before it to drain, the group's
-    // clearing included: a fifth of the build's samples; the build and its `memset`s went
-    // from 11.2 % to 10.7 % of large_pyramid's step.
+    // vectors, as it once was, the first vector load could not be forwarded from the four
+    // scalar stores it spans and waited for every store before it to drain (the group's
+    // clearing, then still done, included): a fifth of the build's samples; the build and
+    // its `memset`s went from 11.2 % to 10.7 % of large_pyramid's step.
     //
     // An empty lane reads an empty input and static bodies (all zeros, as if the lane
     // were skipped) instead of being tested at every column: large_pyramid's build ran
     // 8 % fewer instructions (1 298 → 1 195 a group). Only the tangent impulse of an
     // empty input differs (−0.0), so it is masked.
-    let read: [(&ContactInput, &ConstraintBodies); LANES] =
-        lanes.map(|lane| lane.map_or((&ContactInput::EMPTY, &NO_BODIES), |(_, input, b)| (input, b)));
+    let read: [(&ContactInput, &ConstraintBodies); LANES] = lanes.map(|lane| {
+        lane.map_or((&ContactInput::EMPTY, &ConstraintBodies::STATIC), |(_, input, b)| {
+            (input, b)
+        })
+    });
     let present = M4::from_bools(lanes.map(|lane| lane.is_some()));
     // Each lane's bodies (an empty lane: the static body, not written back).
     hd.index_a = read.map(|(_, b)| b.index_a);
@@ -841,13 +837,13 @@ pub(crate) fn build_group<S: StateRead>(
     (c.mu_s, c.mu_d, c.restitution, c.restitution_threshold) = (*mu_s, *mu_d, *restitution, *threshold);
     let [rolling_resistance, tangent_speed, rolling_impulse, _] = columns(&|input, _| input.surface_row());
     (out.rolling_resistance, out.tangent_speed) = (rolling_resistance, tangent_speed);
-    hd.rolling_impulse = if warm { rolling_impulse } else { zero };
+    let used_rolling_impulse = if warm { rolling_impulse } else { zero };
+    hd.rolling_impulse = used_rolling_impulse;
     // The group's flags and the points' heights, four lanes at once from the columns (an
     // empty lane's zeros set no flag and give the height 0): the scalar tests and the
     // height's `dot`, lane by lane.
     let any_restitution = restitution.gt(zero).any();
     (c.any_restitution, hd.any_restitution) = (any_restitution, any_restitution);
-    let used_rolling_impulse = if warm { rolling_impulse } else { zero };
     hd.any_rolling = (rolling_resistance.gt(zero) | used_rolling_impulse.ne(zero)).any();
     let height = point_rows[0][0] * F4::splat(up.x) + point_rows[0][1] * F4::splat(up.y);
     c.height = *has[0].select(height, zero);
@@ -1566,66 +1562,116 @@ mod tests {
             (0.0, 0.0, 0.0)
         );
         assert!(h.any_rolling && cold.any_restitution && w.block.lane(0));
-        // The empty lane reads as zeros everywhere, +0.0 to the bit (an empty input's
-        // tangent impulse, a sum over no points, would be −0.0).
-        let p = |i: usize| {
-            [
-                h.points[i].r_a.x,
-                h.points[i].r_b.y,
-                h.points[i].normal_impulse,
-                w.points[i].base_separation,
-            ]
-        };
-        let empty = [
-            [
-                h.normal.x,
-                h.normal.y,
-                h.inv_mass_a,
-                h.inv_i_b,
-                h.tangent_impulse,
-                h.rolling_impulse,
-                w.mu,
-                w.tangent_mass,
-            ],
-            [p(0), p(1)].concat().try_into().unwrap_or([F4::splat(1.0); 8]),
+        // What the empty lane reads from its input and bodies is +0.0 to the bit (an
+        // empty input's tangent impulse, a sum over no points, would be −0.0; `split` and
+        // `shift_cap2` are derived from the zero masses: 0.5 and f32::MAX).
+        let mut empty = vec![
+            h.normal.x,
+            h.normal.y,
+            h.inv_mass_a,
+            h.inv_i_a,
+            h.inv_mass_b,
+            h.inv_i_b,
+            h.tangent_impulse,
+            h.rolling_impulse,
+            w.mu,
+            w.tangent_speed,
+            w.rolling_resistance,
+            w.tangent_mass,
+            w.base_drift,
         ];
-        assert!(empty.iter().flatten().all(|x| x[3].to_bits() == 0), "{empty:?}");
+        for i in 0..2 {
+            let (hp, wp) = (&h.points[i], &w.points[i]);
+            empty.extend([hp.r_a.x, hp.r_a.y, hp.r_b.x, hp.r_b.y, hp.normal_impulse]);
+            empty.extend([wp.base_separation, wp.normal_mass, wp.preload]);
+        }
+        let cold_lane = [cold.mu_s[3], cold.mu_d[3], cold.restitution[3], cold.height[3]];
+        assert!(empty.iter().all(|x| x[3].to_bits() == 0), "{empty:?}");
+        assert_eq!(cold_lane.map(f32::to_bits), [0; 4]);
     }
 
-    /// The build writes every field of the group's `WideHead` and `WideContact` (it no
-    /// longer clears them first): built into records whose every byte is 0x01 (a valid
-    /// `true`, a nonzero float and mask), the group comes out as built into zeroed ones,
-    /// with and without warm starting (whose fields it writes either way).
+    /// A group whose every field holds a value (`k` = 0 or 1: two different ones, the
+    /// booleans both ways) that the build must overwrite. A full literal, no `..`: a field
+    /// added to either record does not compile here until it is poisoned too.
+    fn poisoned(k: usize) -> (WideHead, WideContact) {
+        let (x, flag, index) = ([7.5, -7.5][k], k == 0, [7, 9][k]);
+        let x = F4::splat(x);
+        let v = V4 { x, y: x };
+        let m = M4::new([[0x0101_0101, u32::MAX][k]; LANES]);
+        let hp = HeadPoint {
+            r_a: v,
+            r_b: v,
+            normal_impulse: x,
+            substep_vn: x,
+        };
+        let wp = WidePoint {
+            base_separation: x,
+            normal_mass: x,
+            preload: x,
+            total_normal_impulse: x,
+            max_normal_impulse: x,
+            approach: x,
+        };
+        let head = WideHead {
+            index_a: [index; LANES],
+            index_b: [index; LANES],
+            write_a: [flag; LANES],
+            write_b: [flag; LANES],
+            any_rolling: flag,
+            any_restitution: flag,
+            normal: v,
+            inv_mass_a: x,
+            inv_i_a: x,
+            inv_mass_b: x,
+            inv_i_b: x,
+            split: x,
+            shift_cap2: x,
+            points: [hp; 2],
+            tangent_impulse: x,
+            two_points: m,
+            rolling_impulse: x,
+        };
+        let w = WideContact {
+            mu: x,
+            tangent_speed: x,
+            rolling_resistance: x,
+            points: [wp; 2],
+            k11: x,
+            k12: x,
+            k22: x,
+            inv_det: x,
+            block: m,
+            tangent_mass: x,
+            base_drift: x,
+            stick: m,
+            total_tangent_impulse: x,
+            saturated: m,
+        };
+        (head, w)
+    }
+
+    /// The build writes every field of the group's `WideHead` and `WideContact` (it does
+    /// not clear them first): built over either poisoned group ([`poisoned`]), the group
+    /// comes out as built into zeroed ones, with and without warm starting (whose fields
+    /// it writes either way). Checked by mutation: without the zero written into `approach`
+    /// or the rolling impulse left unwritten without warm starting, it fails.
     #[test]
-    #[allow(unsafe_code)]
     fn build_writes_every_field() {
         let f = fixture();
-        for warm in [true, false] {
+        for (warm, k) in [(true, 0), (true, 1), (false, 0), (false, 1)] {
             let ctx = StepContext {
                 warm_starting: warm,
                 ..f.ctx
             };
             let clean = built(f.lanes(), f.up, &ctx, &f.states);
-            let (mut h, mut w, mut cold, mut dv) = built(f.lanes(), f.up, &ctx, &f.states);
-            // SAFETY: every field of both records (u32, bool, f32 lanes, masks) is valid
-            // for the byte 0x01 (bool: true).
-            unsafe {
-                core::ptr::write_bytes(&mut h as *mut WideHead, 0x01, 1);
-                core::ptr::write_bytes(&mut w as *mut WideContact, 0x01, 1);
-            }
-            assert!(h.write_a[3] && w.approach_is_poisoned(), "poisoned");
+            let (_, _, mut cold, mut dv) = clean;
+            let (mut h, mut w) = poisoned(k);
             build_group(&mut h, &mut w, &mut cold, &mut dv, f.lanes(), f.up, &ctx, &f.states);
             assert_eq!(
                 format!("{:?}", (clean.0, clean.1)),
                 format!("{:?}", (h, w)),
-                "warm {warm}"
+                "warm {warm}, poison {k}"
             );
-        }
-    }
-
-    impl WideContact {
-        fn approach_is_poisoned(&self) -> bool {
-            self.points[1].approach[0].to_bits() == 0x0101_0101
         }
     }
 

@@ -49,10 +49,10 @@ pub(crate) struct BodyState {
 }
 
 /// A body's [`BodyState`] shared by the worker threads of a step: plain memory, read and
-/// written without atomics (one of the crate's five `unsafe` sites; the others are
-/// [`SharedState::from_mut_slice`],
-/// [`prefetch`], the SSE intrinsics of [`wide`] and the row access of [`rows_at`] and
-/// [`write_velocity_row`]).
+/// written without atomics (one of the crate's six `unsafe` sites; the others are
+/// [`SharedState::from_mut_slice`], [`prefetch`], the SSE intrinsics of [`wide`], the lanes
+/// of a [`wide`] register read as an array (its `Deref`) and the row access of [`rows_at`]
+/// and [`write_velocity_row`]).
 ///
 /// Why it is race-free — the contract every user of [`StateCell`] for `SharedState` keeps:
 /// - a constraint pass runs colour by colour, and the constraints of one colour share no
