@@ -101,6 +101,7 @@ impl Candidate {
         let input = &self.input;
         let b = &self.bodies;
         let flag = |on: bool, bit: u8| if on { bit } else { 0 };
+        let [moving_a, moving_b] = b.moving();
         *key = ColourKey {
             index_a: b.index_a,
             index_b: b.index_b,
@@ -108,8 +109,8 @@ impl Candidate {
             flags: flag(fast_first(input), FAST)
                 | flag(input.count < 2, SINGLE)
                 | flag(input.may_be_new_resting(), FRESH)
-                | flag(b.index_a != 0 && dynamic_side(b.inv_mass_a, b.inv_i_a), KEY_DYNAMIC_A)
-                | flag(b.index_b != 0 && dynamic_side(b.inv_mass_b, b.inv_i_b), KEY_DYNAMIC_B)
+                | flag(moving_a, KEY_DYNAMIC_A)
+                | flag(moving_b, KEY_DYNAMIC_B)
                 | flag(mass_ratio(b).is_some(), KEY_RATIO)
                 | flag(input.restitution > 0.0, KEY_RESTITUTION),
         };
@@ -486,12 +487,6 @@ const _: () = assert!((COLORS as u8 - 1) | COLOUR_FLAGS != OVERFLOW);
 #[inline]
 fn fast_first(input: &ContactInput) -> bool {
     input.count == 2 && input.points[0].normal_impulse > 0.0 && input.points[1].normal_impulse > 0.0
-}
-
-/// Whether a constraint side is a dynamic body (moves under impulses).
-#[inline]
-fn dynamic_side(inv_mass: f32, inv_i: f32) -> bool {
-    inv_mass > 0.0 || inv_i > 0.0
 }
 
 impl ContactSolver {

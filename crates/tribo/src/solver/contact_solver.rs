@@ -160,6 +160,18 @@ impl ConstraintBodies {
         center_b: Vec2::ZERO,
     };
 
+    /// Whether side A and side B are moving bodies, the ones the solver writes back: a
+    /// body with mass or inertia, not the static slot 0 (the colouring's keys and the wide
+    /// build's write flags).
+    #[inline(always)]
+    pub fn moving(&self) -> [bool; 2] {
+        let side = |index: u32, inv_mass: f32, inv_i: f32| (inv_mass > 0.0 || inv_i > 0.0) && index != 0;
+        [
+            side(self.index_a, self.inv_mass_a, self.inv_i_a),
+            side(self.index_b, self.inv_mass_b, self.inv_i_b),
+        ]
+    }
+
     /// The inverse masses and inertias (A's, then B's), side by side in the record: one
     /// row of the wide build's transpose.
     #[inline(always)]

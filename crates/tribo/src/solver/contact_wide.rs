@@ -758,8 +758,8 @@ pub(crate) fn build_group<S: StateRead>(
     // Each lane's bodies (an empty lane: the static body, not written back).
     hd.index_a = read.map(|(_, b)| b.index_a);
     hd.index_b = read.map(|(_, b)| b.index_b);
-    hd.write_a = read.map(|(_, b)| (b.inv_mass_a > 0.0 || b.inv_i_a > 0.0) && b.index_a != 0);
-    hd.write_b = read.map(|(_, b)| (b.inv_mass_b > 0.0 || b.inv_i_b > 0.0) && b.index_b != 0);
+    hd.write_a = read.map(|(_, b)| b.moving()[0]);
+    hd.write_b = read.map(|(_, b)| b.moving()[1]);
     let each = |f: &dyn Fn(&ContactInput, &ConstraintBodies) -> f32| {
         F4::new(core::array::from_fn(|l| f(read[l].0, read[l].1)))
     };
