@@ -701,12 +701,6 @@ impl V4 {
         self.x * o.y - self.y * o.x
     }
 
-    /// (−y, x): the vector turned counter-clockwise.
-    #[inline(always)]
-    pub fn left_perp(self) -> V4 {
-        V4 { x: -self.y, y: self.x }
-    }
-
     #[inline(always)]
     pub fn scale(self, s: F4) -> V4 {
         V4 {

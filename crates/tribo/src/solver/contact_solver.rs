@@ -1011,8 +1011,15 @@ impl RowFrame {
 
     /// The moments (r_a × u, r_b × u) [m] of a point's lever arms (anchors `r_a`, `r_b`
     /// at the step start, moved by [`lever_arms`]) and the displacement [m] of its material
-    /// points along `u`: [`anchor_displacement`]`(..).dot(u)` =
+    /// points along `u` since the step start, to first order in the rotation:
+    /// `(Δp_b − Δp_a + sin(Δθ_b) ẑ×r_b − sin(Δθ_a) ẑ×r_a)·u` =
     /// d·u + sin Δθ_b (r_b × u) − sin Δθ_a (r_a × u).
+    ///
+    /// Box2D v3 rotates the anchors fully; the second-order term `(cos Δθ − 1) r` then lifts
+    /// a spinning disk off the ground (its material point rises although its surface does
+    /// not), which weakens the contact of a rolling or skidding disk (the
+    /// "slipping-to-rolling comes late" error of Box2D and Rapier). The first-order form
+    /// matches the velocity Jacobian.
     #[inline]
     fn point(&self, a: &BodyState, b: &BodyState, r_a: Vec2, r_b: Vec2) -> ((f32, f32), f32) {
         let (ma, mb) = (r_a.cross(self.u), r_b.cross(self.u));
@@ -1063,12 +1070,9 @@ fn apply(cc: &ContactConstraint, a: &mut BodyState, b: &mut BodyState, r_a: Vec2
 }
 
 /// Relative displacement of the contact point's two material points since the step start,
-/// to first order in the rotation: `Δp_b − Δp_a + sin(Δθ_b) ẑ×r_b − sin(Δθ_a) ẑ×r_a`.
-/// Box2D v3 rotates the anchors fully; the second-order term `(cos Δθ − 1) r` then lifts a
-/// spinning disk off the ground (its material point rises although its surface does not),
-/// which weakens the contact of a rolling or skidding disk (the "slipping-to-rolling comes
-/// late" error of Box2D and Rapier). The first-order form matches the velocity Jacobian.
-#[inline]
+/// to first order in the rotation (see [`RowFrame::point`], which the passes use: its
+/// projection on a row direction); the reference the moment form is tested against.
+#[cfg(test)]
 fn anchor_displacement(a: &BodyState, b: &BodyState, r_a: Vec2, r_b: Vec2) -> Vec2 {
     (b.dp - a.dp) + (b.dq.s * r_b.left_perp() - a.dq.s * r_a.left_perp())
 }
@@ -1392,7 +1396,8 @@ pub(crate) fn store_impulses<S: StateRead>(
         );
         ps.preload = next_preload(cp.preload, cp.normal_impulse, cp.max_normal_impulse, cp.fresh, bounced);
         ps.fresh = false;
-        let vt = point_velocity(cc, &a, &b, cp.r_a, cp.r_b).dot(t) - cc.tangent_speed;
+        let (m, disp) = RowFrame::new(cc, &a, &b, t).point(&a, &b, cp.r_a, cp.r_b);
+        let vt = row_speed(&a, &b, t, m) - cc.tangent_speed;
         ps.slip_speed = vt.abs();
         let loaded = cp.max_normal_impulse > 0.0;
         let mut stick = cp.stick;
@@ -1404,8 +1409,7 @@ pub(crate) fn store_impulses<S: StateRead>(
             }
         }
         ps.drift = if stick && cp.stick && loaded {
-            let d = anchor_displacement(&a, &b, cp.r_a, cp.r_b);
-            d.dot(t) + cp.base_drift - cc.tangent_speed * ctx.dt
+            disp + cp.base_drift - cc.tangent_speed * ctx.dt
         } else {
             0.0
         };

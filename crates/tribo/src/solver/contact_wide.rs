@@ -312,8 +312,8 @@ impl RowFrame {
     }
 
     /// The moments of a point's lever arms (anchors `r_a`, `r_b` at the step start) and
-    /// the displacement of its material points along `u` [m]
-    /// (`anchor_displacement(..).dot(u)`: d·u + sin Δθ_b (r_b × u) − sin Δθ_a (r_a × u)).
+    /// the first-order displacement of its material points along `u` [m]
+    /// (`contact_solver::RowFrame::point`: d·u + sin Δθ_b (r_b × u) − sin Δθ_a (r_a × u)).
     #[inline(always)]
     fn point(&self, a: &WideBody, b: &WideBody, r_a: V4, r_b: V4) -> ((F4, F4), F4) {
         let (ma, mb) = moments((r_a, r_b), self.u);
@@ -339,13 +339,6 @@ fn apply_row(c: &WideHead, a: &mut WideBody, b: &mut WideBody, u: V4, m: (F4, F4
     a.w -= c.inv_i_a * (m.0 * lambda);
     b.v = b.v + u.scale(c.inv_mass_b * lambda);
     b.w += c.inv_i_b * (m.1 * lambda);
-}
-
-/// First-order relative displacement of the material points (see
-/// `contact_solver::anchor_displacement`).
-#[inline(always)]
-fn anchor_displacement(a: &WideBody, b: &WideBody, d: V4, r_a: V4, r_b: V4) -> V4 {
-    d + (r_b.left_perp().scale(b.dq_s) - r_a.left_perp().scale(a.dq_s))
 }
 
 /// The friction row's anchors: the middle of a two-point patch, else the single point
@@ -1069,13 +1062,14 @@ pub(crate) fn store_group<S: StateRead>(
     let shift = capped_shift(h, d);
     let n = h.normal;
     let t = V4 { x: n.y, y: -n.x };
+    let frame = RowFrame::new(h, d, shift, t);
     let mut vt = [F4::ZERO; 2];
     let mut disp = [F4::ZERO; 2];
     for i in 0..2 {
         let p = &h.points[i];
-        let (r_a, r_b) = lever_arms(h, shift, p.r_a, p.r_b);
-        vt[i] = relative_velocity(&a, &b, r_a, r_b).dot(t) - w.tangent_speed;
-        disp[i] = anchor_displacement(&a, &b, d, p.r_a, p.r_b).dot(t);
+        let (m, along) = frame.point(&a, &b, p.r_a, p.r_b);
+        vt[i] = row_speed(&a, &b, t, m) - w.tangent_speed;
+        disp[i] = along;
     }
     // Four lanes at once; every expression is the scalar store's, in its order.
     let zero = F4::ZERO;
