@@ -158,28 +158,29 @@ pub(crate) struct WideCold {
 
 /// What every pass of a step would derive again from a group's [`WideHead`] and
 /// [`WideContact`], made once a step ([`WideDerived::new`]) and kept in an array of its own: the
-/// friction row's anchors [m] and K⁻¹ = [k22, −k12; −k12, k11] / det K (zero where the
+/// moments of the friction row's anchors and K⁻¹ = [k22, −k12; −k12, k11] / det K (zero where the
 /// block does not apply). Only the passes read it; the build writes it and the store does
 /// not touch it, so neither streams it with the groups. (Kept inside [`WideContact`] it
 /// made large_pyramid's step 2.5 % faster but many_pyramids' 3 % slower: its build and
 /// store streamed the bigger records.)
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WideDerived {
-    pub fr_a: V4,
-    pub fr_b: V4,
+    /// The friction row's anchors' moments about the tangent t = (n.y, −n.x),
+    /// (fr_a × t, fr_b × t) [m] (what the passes' [`RowFrame`] needs of them: 32 bytes
+    /// instead of the anchors' 64, and two cross products a pass fewer).
+    pub fr_moments: (F4, F4),
     pub i11: F4,
     pub i12: F4,
     pub i22: F4,
 }
 
 impl WideDerived {
-    /// From the group's friction anchors `(fr_a, fr_b)` ([`friction_arms`]) and its K and
+    /// From the group's friction anchors ([`friction_arms`]), normal `n` and its K and
     /// 1/det K: the expressions the passes evaluated each time, so the same bits.
     #[inline(always)]
-    fn new((fr_a, fr_b): (V4, V4), w: &WideContact) -> WideDerived {
+    fn new(friction: (V4, V4), n: V4, w: &WideContact) -> WideDerived {
         WideDerived {
-            fr_a,
-            fr_b,
+            fr_moments: moments(friction, V4 { x: n.y, y: -n.x }),
             i11: w.k22 * w.inv_det,
             i12: -w.k12 * w.inv_det,
             i22: w.k11 * w.inv_det,
@@ -188,7 +189,7 @@ impl WideDerived {
 }
 
 // What the hot passes stream per group of four constraints (bytes).
-const _: () = assert!(core::mem::size_of::<WideDerived>() == 112);
+const _: () = assert!(core::mem::size_of::<WideDerived>() == 80);
 const _: () = assert!(core::mem::size_of::<WideContact>() == 400);
 const _: () = assert!(core::mem::size_of::<WideHead>() == 416);
 
@@ -316,7 +317,12 @@ impl RowFrame {
     /// (`contact_solver::RowFrame::point`: d·u + sin Δθ_b (r_b × u) − sin Δθ_a (r_a × u)).
     #[inline(always)]
     fn point(&self, a: &WideBody, b: &WideBody, r_a: V4, r_b: V4) -> ((F4, F4), F4) {
-        let (ma, mb) = moments((r_a, r_b), self.u);
+        self.point_of(a, b, moments((r_a, r_b), self.u))
+    }
+
+    /// [`RowFrame::point`] from the anchors' moments about `u`, (r_a × u, r_b × u).
+    #[inline(always)]
+    fn point_of(&self, a: &WideBody, b: &WideBody, (ma, mb): (F4, F4)) -> ((F4, F4), F4) {
         let disp = self.along + b.dq_s * mb - a.dq_s * ma;
         ((ma + self.shift_a, mb - self.shift_b), disp)
     }
@@ -740,7 +746,7 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
 
     // Friction row (contact_solver::solve_friction).
     let t = V4 { x: n.y, y: -n.x };
-    let (m, disp) = RowFrame::new(h, d, shift, t).point(&a, &b, dv.fr_a, dv.fr_b);
+    let (m, disp) = RowFrame::new(h, d, shift, t).point_of(&a, &b, dv.fr_moments);
     let limit = c.mu * (new0 + new1);
     let vt = row_speed(&a, &b, t, m) - c.tangent_speed;
     let fbias = if USE_BIAS {
@@ -998,7 +1004,7 @@ pub(crate) fn build_group<S: StateRead>(
     out.k12 = block.select(k12, zero);
     out.k22 = block.select(k22, zero);
     out.inv_det = block.select(inv, zero);
-    *derived = WideDerived::new((fr_a, fr_b), out);
+    *derived = WideDerived::new((fr_a, fr_b), n, out);
 }
 
 /// `contact_solver::shift_cap2` four lanes at once (the same quotients and minimum; the
@@ -1318,7 +1324,7 @@ pub(crate) fn pack(
     w.mu[l] = if stick { cc.mu_s } else { cc.mu_d };
     h.two_points[l] = if cc.count == 2 { u32::MAX } else { 0 };
     pack_state(h, w, l, cc);
-    *derived = WideDerived::new(friction_arms(h), w);
+    *derived = WideDerived::new(friction_arms(h), h.normal, w);
 }
 
 /// Copies the parts of a constraint that change during the substeps into lane `l`.
@@ -1598,18 +1604,19 @@ mod tests {
         assert_eq!(format!("{w:?}"), format!("{r:?}"));
         assert_eq!(format!("{cold:?}"), format!("{rcold:?}"));
         assert_eq!(format!("{dv:?}"), format!("{rdv:?}"));
-        // The ready-made part, lane by lane from the scalar build: the friction row at the
-        // middle of two points (at the point of one), K⁻¹ from the block's K and 1/det K
+        // The ready-made part, lane by lane from the scalar build: the moments of the
+        // friction row's anchors, at the middle of two points (at the point of one), K⁻¹ from the block's K and 1/det K
         // (zeros, the middle one −0, where the block does not apply), to the bit.
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
             let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
             let [p0, p1] = &cc.points;
             let anchor = |a: Vec2, b: Vec2| if cc.count == 2 { (a + b) * 0.5 } else { a };
             let (fr_a, fr_b) = (anchor(p0.r_a, p1.r_a), anchor(p0.r_b, p1.r_b));
+            let t = cc.normal.right_perp();
             let block = cc.count == 2 && cc.block;
             let ([k11, k12, k22], inv) = if block { (cc.k, cc.inv_det) } else { ([0.0; 3], 0.0) };
-            let expected = [fr_a.x, fr_a.y, fr_b.x, fr_b.y, k22 * inv, -k12 * inv, k11 * inv];
-            let lane = [dv.fr_a.x, dv.fr_a.y, dv.fr_b.x, dv.fr_b.y, dv.i11, dv.i12, dv.i22].map(|x| x[l]);
+            let expected = [fr_a.cross(t), fr_b.cross(t), k22 * inv, -k12 * inv, k11 * inv];
+            let lane = [dv.fr_moments.0, dv.fr_moments.1, dv.i11, dv.i12, dv.i22].map(|x| x[l]);
             assert_eq!(lane.map(f32::to_bits), expected.map(f32::to_bits), "lane {l}");
         }
         // What the lanes derive instead of storing (softness, K⁻¹, rolling mass, friction
