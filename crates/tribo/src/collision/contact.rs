@@ -116,8 +116,9 @@ pub(crate) struct Contact {
 
 const _: () = assert!(core::mem::size_of::<Contact>() == 320);
 
-/// What a contact keeps of its last full collision to skip the next: the recycling basis
-/// of a touching pair, or the distance bound of a pair found apart. A contact is one or
+/// What a contact keeps of its last full collision to skip the next: for a touching pair
+/// its poses then, which its first recycle turns into the recycling basis, or the distance
+/// bound of a pair found apart. A contact is one or
 /// the other, never both, so the two share their bytes: the record is five cache lines,
 /// not six (the narrow phase streams every awake contact each step).
 ///
@@ -326,10 +327,15 @@ impl Contact {
         if count == 0 {
             return false;
         }
-        if let Memo::Posed { xf_a, xf_b } = self.memo {
-            // The manifold is still the one computed at these poses (only a recycle, which
-            // first makes the basis, changes it).
-            self.memo = Memo::Basis(RecycleBasis::of(&self.manifold, xf_a, xf_b));
+        if let Memo::Posed {
+            xf_a: then_a,
+            xf_b: then_b,
+        } = self.memo
+        {
+            // The manifold is still the one computed at these poses: a recycle first makes
+            // the basis, and `update` and `clear_manifold` replace the memo with the
+            // manifold.
+            self.memo = Memo::Basis(RecycleBasis::of(&self.manifold, then_a, then_b));
         }
         let Memo::Basis(basis) = &self.memo else {
             return false;

@@ -113,8 +113,8 @@ pub(crate) struct WideHead {
 /// records and the store reads them: every step streams them): the softness (from whether
 /// a side is static), 1/k11 and 1/k22 (the points' normal masses where the block applies)
 /// and the rolling mass (from the inverse inertias) are derived where they are used; K⁻¹
-/// and the friction row's anchors, which every pass would derive, are in the group's
-/// [`WideDerived`]. 400 bytes (was 608). [`build_group`] writes every field (see
+/// and the moments of the friction row's anchors, which every pass would derive, are in
+/// the group's [`WideDerived`]. 400 bytes (was 608). [`build_group`] writes every field (see
 /// [`WideHead`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WideContact {
@@ -175,12 +175,12 @@ pub(crate) struct WideDerived {
 }
 
 impl WideDerived {
-    /// From the group's friction anchors ([`friction_arms`]), normal `n` and its K and
+    /// From the group's friction anchors ([`friction_arms`]), tangent `t` and its K and
     /// 1/det K: the expressions the passes evaluated each time, so the same bits.
     #[inline(always)]
-    fn new(friction: (V4, V4), n: V4, w: &WideContact) -> WideDerived {
+    fn new(friction: (V4, V4), t: V4, w: &WideContact) -> WideDerived {
         WideDerived {
-            fr_moments: moments(friction, V4 { x: n.y, y: -n.x }),
+            fr_moments: moments(friction, t),
             i11: w.k22 * w.inv_det,
             i12: -w.k12 * w.inv_det,
             i22: w.k11 * w.inv_det,
@@ -1004,7 +1004,7 @@ pub(crate) fn build_group<S: StateRead>(
     out.k12 = block.select(k12, zero);
     out.k22 = block.select(k22, zero);
     out.inv_det = block.select(inv, zero);
-    *derived = WideDerived::new((fr_a, fr_b), n, out);
+    *derived = WideDerived::new((fr_a, fr_b), t, out);
 }
 
 /// `contact_solver::shift_cap2` four lanes at once (the same quotients and minimum; the
@@ -1052,7 +1052,7 @@ fn write_stored(c: &mut Contact, count: u8, rolling_impulse: f32, set: impl Fn(u
 
 /// The store stage for four constraints, in group order: exactly what
 /// `contact_solver::store_impulses` computes for each lane (the end-of-step slip velocity
-/// and anchor displacement four lanes at a time, the sums and the stick/slip transitions
+/// and the displacement along the tangent four lanes at a time, the sums and the stick/slip transitions
 /// lane by lane), transposed into each lane's rows for the contacts to take in contact
 /// order ([`StoredGroup::write_into`]).
 pub(crate) fn store_group<S: StateRead>(
@@ -1324,7 +1324,8 @@ pub(crate) fn pack(
     w.mu[l] = if stick { cc.mu_s } else { cc.mu_d };
     h.two_points[l] = if cc.count == 2 { u32::MAX } else { 0 };
     pack_state(h, w, l, cc);
-    *derived = WideDerived::new(friction_arms(h), h.normal, w);
+    let n = h.normal;
+    *derived = WideDerived::new(friction_arms(h), V4 { x: n.y, y: -n.x }, w);
 }
 
 /// Copies the parts of a constraint that change during the substeps into lane `l`.
@@ -1605,8 +1606,9 @@ mod tests {
         assert_eq!(format!("{cold:?}"), format!("{rcold:?}"));
         assert_eq!(format!("{dv:?}"), format!("{rdv:?}"));
         // The ready-made part, lane by lane from the scalar build: the moments of the
-        // friction row's anchors, at the middle of two points (at the point of one), K⁻¹ from the block's K and 1/det K
-        // (zeros, the middle one −0, where the block does not apply), to the bit.
+        // friction row's anchors, at the middle of two points (at the point of one), K⁻¹
+        // from the block's K and 1/det K (zeros, the middle one −0, where the block does
+        // not apply), to the bit.
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
             let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
             let [p0, p1] = &cc.points;
@@ -1813,16 +1815,27 @@ mod tests {
             state(2.0, -0.8, 0.0),
             state(0.1, 0.3, 0.2),
             state(-0.6, -0.9, 0.4),
+            // Slid 0.4 m along the contact face since the step start: the lever arms'
+            // shift is capped (√(ρ²/4) ≈ 0.2 m for these bodies, `capped_shift`).
+            moved_state(0.3, -0.2, 0.5, Vec2::new(0.4, -2e-3), 1e-2),
+            state(-0.2, -0.4, -0.3),
         ];
         let cases = [
             (3u32, input(points, false, 0.0, 0.0), bodies(1, 2)),
             (5, input(points, true, 0.0, 0.0), bodies(0, 3)),
             (8, input(points, false, 0.0, 0.05), bodies(4, 5)),
+            (11, input(points, false, 0.0, 0.0), bodies(6, 7)),
         ];
         let lanes: [LaneInput<'_>; LANES] = core::array::from_fn(|l| cases.get(l).map(|c| (c.0, &c.1, &c.2)));
         let (mut h, mut w, cold, dv) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
+        let over_cap = |l: usize| {
+            let d = states[7].dp - states[6].dp;
+            d.length_squared() > h.shift_cap2[l]
+        };
+        assert!(over_cap(3), "lane 3's shift is capped");
         let built = (h, w);
-        let mut scalar: Vec<ContactConstraint> = (0..3).map(|l| unpack_full(&h, &w, &cold, &soft, l)).collect();
+        let mut scalar: Vec<ContactConstraint> =
+            (0..cases.len()).map(|l| unpack_full(&h, &w, &cold, &soft, l)).collect();
         let cells = |s: &[BodyState]| -> Vec<core::cell::Cell<BodyState>> {
             s.iter().map(|&s| core::cell::Cell::new(s)).collect()
         };

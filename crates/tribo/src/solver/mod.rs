@@ -39,8 +39,10 @@ pub(crate) struct BodyState {
     pub v: Vec2,
     /// Angular velocity [rad/s].
     pub w: f32,
-    /// 1 when a contact pushed the body in the current substep, else 0 (keeps the
-    /// 32-byte layout; a float so the struct stays plain data).
+    /// 1 when a contact pushed the body (or a joint acted on it) in the current substep's
+    /// biased pass, else 0: set there, read by the positions' integration that follows,
+    /// cleared by `integrate_velocities`. The relax writes 0 (dead until then). Keeps the
+    /// 32-byte layout; a float so the struct stays plain data.
     pub touched: f32,
     /// Translation of the centre of mass since the start of the step [m].
     pub dp: Vec2,
