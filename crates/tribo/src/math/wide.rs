@@ -701,6 +701,12 @@ impl V4 {
         self.x * o.y - self.y * o.x
     }
 
+    /// (y, −x): the vector turned clockwise (`Vec2::right_perp`; the tangent of a normal).
+    #[inline(always)]
+    pub fn right_perp(self) -> V4 {
+        V4 { x: self.y, y: -self.x }
+    }
+
     #[inline(always)]
     pub fn scale(self, s: F4) -> V4 {
         V4 {

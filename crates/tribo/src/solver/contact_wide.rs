@@ -401,7 +401,7 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
     let mut b = gather(states, &c.index_b);
     let shift = capped_shift(c, b.dp - a.dp);
     let n = c.normal;
-    let t = V4 { x: n.y, y: -n.x };
+    let t = n.right_perp();
     let mut arms = [(V4::default(), V4::default()); 2];
     for (i, arm) in arms.iter_mut().enumerate() {
         let p = &c.points[i];
@@ -745,7 +745,7 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     }
 
     // Friction row (contact_solver::solve_friction).
-    let t = V4 { x: n.y, y: -n.x };
+    let t = n.right_perp();
     let (m, disp) = RowFrame::new(h, d, shift, t).point_of(&a, &b, dv.fr_moments);
     let limit = c.mu * (new0 + new1);
     let vt = row_speed(&a, &b, t, m) - c.tangent_speed;
@@ -958,7 +958,7 @@ pub(crate) fn build_group<S: StateRead>(
     out.mu = out.stick.select(mu_s, mu_d);
     // Four lanes at once (contact_solver::build_constraint and pack).
     let n = hd.normal;
-    let t = V4 { x: n.y, y: -n.x };
+    let t = n.right_perp();
     // k = m_a⁻¹ + m_b⁻¹ + I_a⁻¹ (r_a × d)² + I_b⁻¹ (r_b × d)² (effective_mass_inv).
     let k_of = |r_a: V4, r_b: V4, d: V4| {
         let (ra, rb) = (r_a.cross(d), r_b.cross(d));
@@ -1067,15 +1067,14 @@ pub(crate) fn store_group<S: StateRead>(
     let d = b.dp - a.dp;
     let shift = capped_shift(h, d);
     let n = h.normal;
-    let t = V4 { x: n.y, y: -n.x };
+    let t = n.right_perp();
     let frame = RowFrame::new(h, d, shift, t);
     let mut vt = [F4::ZERO; 2];
     let mut disp = [F4::ZERO; 2];
     for i in 0..2 {
         let p = &h.points[i];
         let (m, along) = frame.point(&a, &b, p.r_a, p.r_b);
-        vt[i] = row_speed(&a, &b, t, m) - w.tangent_speed;
-        disp[i] = along;
+        (vt[i], disp[i]) = (row_speed(&a, &b, t, m) - w.tangent_speed, along);
     }
     // Four lanes at once; every expression is the scalar store's, in its order.
     let zero = F4::ZERO;
@@ -1324,8 +1323,7 @@ pub(crate) fn pack(
     w.mu[l] = if stick { cc.mu_s } else { cc.mu_d };
     h.two_points[l] = if cc.count == 2 { u32::MAX } else { 0 };
     pack_state(h, w, l, cc);
-    let n = h.normal;
-    *derived = WideDerived::new(friction_arms(h), V4 { x: n.y, y: -n.x }, w);
+    *derived = WideDerived::new(friction_arms(h), h.normal.right_perp(), w);
 }
 
 /// Copies the parts of a constraint that change during the substeps into lane `l`.
@@ -1828,11 +1826,8 @@ mod tests {
         ];
         let lanes: [LaneInput<'_>; LANES] = core::array::from_fn(|l| cases.get(l).map(|c| (c.0, &c.1, &c.2)));
         let (mut h, mut w, cold, dv) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
-        let over_cap = |l: usize| {
-            let d = states[7].dp - states[6].dp;
-            d.length_squared() > h.shift_cap2[l]
-        };
-        assert!(over_cap(3), "lane 3's shift is capped");
+        let d = states[7].dp - states[6].dp;
+        assert!(d.length_squared() > h.shift_cap2[3], "lane 3's shift is capped");
         let built = (h, w);
         let mut scalar: Vec<ContactConstraint> =
             (0..cases.len()).map(|l| unpack_full(&h, &w, &cold, &soft, l)).collect();
