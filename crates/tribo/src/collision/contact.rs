@@ -208,20 +208,26 @@ impl RecycleBasis {
 }
 
 /// Largest relative motion [m] of a contact's material points since its manifold was
-/// computed for which the manifold is reused: the linear slop, the overlap the solver
-/// already tolerates. A manifold's points are material points of the two bodies, so the
-/// separations are refreshed from the points instead of colliding the shapes again.
+/// computed for which the manifold is reused: twice the linear slop (1 cm). A manifold's
+/// points are material points of the two bodies, so the separations are refreshed from the
+/// points instead of colliding the shapes again.
 ///
 /// What reuse costs in accuracy, within this distance: a vertex sliding on a face (the
 /// common point of polygon contacts) keeps its exact separation, the face being flat; a
-/// point clipped at a face's end may ride up to 5 mm past it; a rolling disk's point turns
-/// by at most 5 mm / R (separation error R (1 − cos θ), 25 µm for R = 0.5 m), and a
+/// point clipped at a face's end may ride up to 1 cm past it; a rolling disk's point turns
+/// by at most 1 cm / R (separation error R (1 − cos θ), 0.1 mm for R = 0.5 m), and a
 /// tipping box is caught by the rotation test. Only pairs moving less than the speculative
-/// distance per step qualify (the narrow phase's guard). Box2D v3 reuses manifolds up to
-/// 10 × linear slop (5 cm). Until 2026-12 this was 1 mm (resting pairs only); 5 mm cut the
-/// manifolds computed per step by 42 % in Box2D's washer, 36 % in its tumbler, 34 % in
-/// junkyard and 17 % in smash.
-pub(crate) const RECYCLE_DISTANCE: f32 = LINEAR_SLOP;
+/// distance plus the linear slop less this distance per step qualify (1.5 cm; the narrow
+/// phase's guard), so that a feature the manifold lacks still cannot overlap by more than
+/// the slop. Box2D v3 reuses manifolds up to 10 × linear slop (5 cm), keeping the anchors
+/// as they were. History: 1 mm (resting pairs only) until 2026-12; then 5 mm, which cut
+/// the manifolds computed per step by 42 % in Box2D's washer, 36 % in its tumbler, 34 % in
+/// junkyard and 17 % in smash; then 1 cm with the 1.5 cm guard: junkyard, tumbler and smash
+/// −1.7 %, −1.7 % and −2.3 % of all instructions (300 steps; most of the pairs that still
+/// failed the 5 mm test had moved 5–15 mm), large_pyramid unchanged. 1.5 cm with a 1 cm
+/// guard, or 1 cm with the manifold made 5 mm wider instead of the guard, did worse
+/// (more pairs too fast to reuse, or more speculative points to carry).
+pub(crate) const RECYCLE_DISTANCE: f32 = 2.0 * LINEAR_SLOP;
 
 impl Contact {
     /// Recomputes the manifold and carries impulses and friction state over to points
@@ -499,20 +505,21 @@ mod tests {
         }
     }
 
-    /// A box sliding along the ground: within the recycle distance (4 mm, no turn) the
+    /// A box sliding along the ground: within the recycle distance (0.8 of it, no turn) the
     /// recycled manifold keeps the same points and the exact separations of a fresh one (a
-    /// vertex on a flat face); beyond it (6 mm) the pair is collided again.
+    /// vertex on a flat face); beyond it (1.2 of it) the pair is collided again.
     #[test]
-    fn a_sliding_box_is_recycled_within_the_slop_with_exact_separations() {
+    fn a_sliding_box_is_recycled_within_the_recycle_distance_with_exact_separations() {
         let ground = Shape::Polygon(Polygon::new_box(5.0, 0.5).unwrap());
         let block = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
         let xf_g = Transform::new(Vec2::new(0.0, -0.5), 0.0);
         let mut c = contact();
         assert!(c.update(&ground, xf_g, &block, Transform::new(Vec2::new(0.3, 0.499), 0.0), 0.02));
-        let slid = Transform::new(Vec2::new(0.304, 0.4985), 0.0);
+        let slid = Transform::new(Vec2::new(0.3 + 0.8 * RECYCLE_DISTANCE, 0.4985), 0.0);
         let (recycled, _) = recycled_and_fresh(&c, &ground, xf_g, &block, slid);
         assert_eq!(recycled.manifold.count, 2);
-        assert!(!c.recycle(xf_g, Transform::new(Vec2::new(0.306, 0.499), 0.0), 2.0 * 0.71));
+        let beyond = Transform::new(Vec2::new(0.3 + 1.2 * RECYCLE_DISTANCE, 0.499), 0.0);
+        assert!(!c.recycle(xf_g, beyond, 2.0 * 0.71));
     }
 
     /// A ground box (top face y = 0), a disk of radius 0.5 m and the ground's pose.
@@ -529,8 +536,8 @@ mod tests {
     /// so a one-point manifold must mask the lanes of its unused slot: even zero there is
     /// a point at a body's origin, which moves as the body turns (and would, unmasked,
     /// refuse recycling by the distance between the origins). A disk resting on the
-    /// ground must recycle when it moves within the slop with points metres away in that
-    /// slot, and still refuse a move beyond the slop.
+    /// ground must recycle when it moves within the recycle distance with points metres
+    /// away in that slot, and still refuse a move beyond it.
     #[test]
     fn a_one_point_manifold_ignores_the_unused_slot_of_its_basis() {
         let (ground, disk, xf_g) = disk_and_ground();
@@ -553,10 +560,9 @@ mod tests {
         let mut recycled = c.clone();
         assert!(recycled.recycle(xf_g, lifted, 2.0 * 0.5));
         assert!((recycled.manifold.points[0].separation - (c.manifold.points[0].separation + 1e-3)).abs() < 1e-6);
-        // Lifted by 6 mm: beyond the slop, collided again.
-        assert!(!c
-            .clone()
-            .recycle(xf_g, Transform::new(Vec2::new(0.0, 0.505), 0.0), 2.0 * 0.5));
+        // Lifted by 1.2 × RECYCLE_DISTANCE: beyond it, collided again.
+        let beyond = Transform::new(Vec2::new(0.0, 0.499 + 1.2 * RECYCLE_DISTANCE), 0.0);
+        assert!(!c.clone().recycle(xf_g, beyond, 2.0 * 0.5));
     }
 
     /// A rolling disk's contact point is not a material point: after rolling 2 cm (well
