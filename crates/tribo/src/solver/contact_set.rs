@@ -574,27 +574,38 @@ impl ContactSolver {
     ) {
         self.layouts += 1;
         self.fresh.clear();
-        self.last_keys.clear();
-        self.layout_kept = true;
-        // 1. Colours.
-        self.used.clear();
-        self.used.resize(states.len(), 0);
-        self.colours.clear();
+        // 1. Colours. The lists it fills are taken out of `self` for the loop: as locals
+        // their lengths stay in registers (as fields, each push reloaded and stored its
+        // vector's length: junkyard's pushes were ~50 instructions a contact).
+        let n = candidates.list.len();
+        let (mut used, mut colours) = (core::mem::take(&mut self.used), core::mem::take(&mut self.colours));
+        let (mut contact_of, mut last_keys) = (
+            core::mem::take(&mut self.contact_of),
+            core::mem::take(&mut self.last_keys),
+        );
+        used.clear();
+        used.resize(states.len(), 0);
+        colours.clear();
+        colours.reserve(n);
+        contact_of.clear();
+        contact_of.reserve(n);
+        last_keys.clear();
+        last_keys.reserve(n);
         let mut counts = [0u32; COLORS];
         // Constraints likely to take the solver's fast path, per colour (see `fast_first`).
         let mut fast_counts = [0u32; COLORS];
         // Constraints of one point or none, per colour (see [`SINGLE`]).
         let mut single_counts = [0u32; COLORS];
         let mut any_restitution = false;
-        self.contact_of.clear();
+        let mut overflow = false;
         for (i, (contact, key)) in candidates.keys().enumerate() {
-            self.contact_of.push(contact);
+            contact_of.push(contact);
             if key.flags & KEY_RATIO != 0 {
                 light.extend(candidates.get(i).and_then(|cand| self.light_body(cand, sims)));
             }
             let (da, db) = (key.flags & KEY_DYNAMIC_A != 0, key.flags & KEY_DYNAMIC_B != 0);
-            let busy = (if da { self.used[key.index_a as usize] } else { 0 })
-                | (if db { self.used[key.index_b as usize] } else { 0 });
+            let busy =
+                (if da { used[key.index_a as usize] } else { 0 }) | (if db { used[key.index_b as usize] } else { 0 });
             // The colour of the last step when it is still free (a pile keeps its layout:
             // `World::reorder_contacts`), else the lowest free colour below DYNAMIC_COLORS, or the
             // highest free one from 1 up (bit scans of the free colours).
@@ -616,28 +627,30 @@ impl ContactSolver {
             match colour {
                 Some(k) => {
                     if da {
-                        self.used[key.index_a as usize] |= 1 << k;
+                        used[key.index_a as usize] |= 1 << k;
                     }
                     if db {
-                        self.used[key.index_b as usize] |= 1 << k;
+                        used[key.index_b as usize] |= 1 << k;
                     }
                     counts[k] += 1;
                     fast_counts[k] += (key.flags & FAST != 0) as u32;
                     single_counts[k] += (key.flags & SINGLE != 0) as u32;
                     any_restitution |= key.flags & KEY_RESTITUTION != 0;
-                    self.colours.push(k as u8 | (key.flags & COLOUR_FLAGS));
-                    self.last_keys.push(ColourKey {
+                    colours.push(k as u8 | (key.flags & COLOUR_FLAGS));
+                    last_keys.push(ColourKey {
                         colour: k as u8,
                         flags: key.flags & !ORDER_FLAGS,
                         ..*key
                     });
                 }
                 None => {
-                    self.colours.push(OVERFLOW);
-                    self.layout_kept = false;
+                    colours.push(OVERFLOW);
+                    overflow = true;
                 }
             }
         }
+        self.layout_kept = !overflow;
+        (self.used, self.colours, self.contact_of, self.last_keys) = (used, colours, contact_of, last_keys);
         self.any_restitution = any_restitution;
         // 2. Layout: colour k fills lanes from `next[k]` on (in lanes, not groups).
         let mut next = [0u32; COLORS];
@@ -674,9 +687,15 @@ impl ContactSolver {
         self.derived.truncate(groups as usize);
         // 3. Slots: overflow constraints are built here, coloured ones below.
         let soft = self.soft;
-        self.slots.clear();
-        self.lane_candidates.clear();
-        self.lane_candidates.resize(groups as usize, [u32::MAX; LANES]);
+        // Locals again for the loop (see step 1).
+        let (mut slots, mut lane_candidates) = (
+            core::mem::take(&mut self.slots),
+            core::mem::take(&mut self.lane_candidates),
+        );
+        slots.clear();
+        slots.reserve(n);
+        lane_candidates.clear();
+        lane_candidates.resize(groups as usize, [u32::MAX; LANES]);
         // Reads only the colour bytes (and the rare overflow candidates), not the candidates.
         for (i, &colour) in self.colours.iter().enumerate() {
             let slot = if colour == OVERFLOW {
@@ -700,7 +719,9 @@ impl ContactSolver {
                 let at = *next;
                 *next += 1;
                 let (group, lane) = (at / LANES as u32, at % LANES as u32);
-                self.lane_candidates[group as usize][lane as usize] = i as u32;
+                if let Some(lanes) = lane_candidates.get_mut(group as usize) {
+                    lanes[lane as usize % LANES] = i as u32;
+                }
                 let slot = Slot::Wide {
                     group,
                     lane: lane as u8,
@@ -710,8 +731,9 @@ impl ContactSolver {
                 }
                 slot
             };
-            self.slots.push(slot);
+            slots.push(slot);
         }
+        (self.slots, self.lane_candidates) = (slots, lane_candidates);
     }
 
     /// Whether last step's colours and layout hold for `candidates` unchanged: the same
