@@ -1073,7 +1073,7 @@ impl World {
         // finds whether one has while it writes the timers: a pile that keeps moving, like
         // the tumbler's, pays nothing here).
         let tts = self.def.time_to_sleep;
-        if !self.any_rested {
+        if !self.any_rested || self.step_count % SLEEP_CHECK_STEPS != 0 {
             return;
         }
         // Islands over the solver slots of the awake bodies (solver order is slot order, so
@@ -1160,6 +1160,11 @@ impl World {
         &self.non_finite
     }
 }
+
+/// Steps between two searches for islands to put to sleep (every step's rest timers are
+/// kept; an island falls asleep at the first search after its least rested body has rested
+/// `WorldDef::time_to_sleep`, up to this many steps less one later).
+pub(super) const SLEEP_CHECK_STEPS: u64 = 4;
 
 /// Bodies per parallel chunk of finalize and of the step's body pass.
 pub(super) const BODY_CHUNK: usize = 256;
