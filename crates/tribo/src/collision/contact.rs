@@ -5,8 +5,8 @@
 //! written back by [`crate::solver`].
 
 use crate::dynamics::MixedMaterial;
-use crate::geometry::LINEAR_SLOP;
 use crate::geometry::{collide_bounded, Manifold, Shape, MAX_MANIFOLD_POINTS};
+use crate::geometry::{LINEAR_SLOP, SPECULATIVE_DISTANCE};
 use crate::math::wide::{apply_lanes, split_xy, F4, M4};
 use crate::math::{Rot, Transform, Vec2};
 use crate::world::ShapeId;
@@ -136,8 +136,7 @@ pub(crate) enum Memo {
     Basis(RecycleBasis),
     /// A touching pair's poses when its manifold was computed, from which
     /// [`Contact::recycle`] makes the [`Memo::Basis`] the first time it tries to reuse the
-    /// manifold. A pair moving faster than the speculative distance per step is collided
-    /// again without trying, so it never needs one: in smash, junkyard and the tumbler
+    /// manifold. A pair too fast to be recycled (more than [`RECYCLE_STEP`] a step) is collided again without trying, so it never needs one: in smash, junkyard and the tumbler
     /// most full collisions are of such pairs, and making the basis each time was a tenth
     /// of a full collision's instructions.
     Posed { xf_a: Transform, xf_b: Transform },
@@ -207,27 +206,46 @@ impl RecycleBasis {
     }
 }
 
-/// Largest relative motion [m] of a contact's material points since its manifold was
-/// computed for which the manifold is reused: twice the linear slop (1 cm). A manifold's
-/// points are material points of the two bodies, so the separations are refreshed from the
-/// points instead of colliding the shapes again.
+/// Largest relative motion [m] of a pair since its manifold was computed for which the
+/// manifold is reused: three times the linear slop (1.5 cm), counted as the largest motion
+/// of a manifold point (each side's surface points seen from the other body) plus the turn
+/// times the reach of the smaller body's features, which together bound how far any
+/// feature of the pair has moved towards the other. A manifold's points are material points
+/// of the two bodies, so the separations are refreshed from the points instead of colliding
+/// the shapes again.
 ///
-/// What reuse costs in accuracy, within this distance: a vertex sliding on a face (the
-/// common point of polygon contacts) keeps its exact separation, the face being flat; a
-/// point clipped at a face's end may ride up to 1 cm past it; a rolling disk's point turns
-/// by at most 1 cm / R (separation error R (1 − cos θ), 0.1 mm for R = 0.5 m), and a
-/// tipping box is caught by the rotation test. Only pairs moving less than the speculative
-/// distance plus the linear slop less this distance per step qualify (1.5 cm; the narrow
-/// phase's guard), so that a feature the manifold lacks still cannot overlap by more than
-/// the slop. Box2D v3 reuses manifolds up to 10 × linear slop (5 cm), keeping the anchors
-/// as they were. History: 1 mm (resting pairs only) until 2026-12; then 5 mm, which cut
-/// the manifolds computed per step by 42 % in Box2D's washer, 36 % in its tumbler, 34 % in
-/// junkyard and 17 % in smash; then 1 cm with the 1.5 cm guard: junkyard, tumbler and smash
-/// −1.7 %, −1.7 % and −2.3 % of all instructions (300 steps; most of the pairs that still
-/// failed the 5 mm test had moved 5–15 mm), large_pyramid unchanged. 1.5 cm with a 1 cm
-/// guard, or 1 cm with the manifold made 5 mm wider instead of the guard, did worse
-/// (more pairs too fast to reuse, or more speculative points to carry).
-pub(crate) const RECYCLE_DISTANCE: f32 = 2.0 * LINEAR_SLOP;
+/// What reuse costs in accuracy, within it: a vertex sliding on a face (the common point of
+/// polygon contacts) keeps its exact separation, the face being flat; a point clipped at a
+/// face's end may ride up to 1.5 cm past it; a tipping box is caught by its turn; pairs
+/// with a rounded shape, whose contact points roll, keep a tighter limit
+/// ([`ROUND_RECYCLE_DISTANCE`]). A feature the manifold lacks was further than
+/// the speculative distance when the manifold was made, has moved by at most this distance
+/// since, and closes by at most [`RECYCLE_STEP`] in the step, so it can overlap by at most
+/// 1.5 cm + 1.5 cm − 2 cm = 1 cm: the bound of the earlier limits (5 mm of point motion and
+/// 5 mm of turn, tested apart, and 2 cm a step). Box2D v3 reuses manifolds up to 10 × linear
+/// slop (5 cm, also motion plus turn times extent), keeping the anchors as they were.
+/// History: 1 mm (resting pairs only) until 2026-12; then 5 mm, which cut the manifolds
+/// computed per step by 42 % in Box2D's washer, 36 % in its tumbler, 34 % in junkyard and
+/// 17 % in smash; then this (instructions over 300 steps against 5 mm: junkyard −1.7 %,
+/// tumbler −2.4 %, smash −2.8 %; most of the slow pairs that still failed the 5 mm tests
+/// had moved 5–15 mm). Tried and dropped: 1 cm of point motion and 1 cm of turn tested
+/// apart (as fast, but a missed feature could overlap by 1.5 cm); 1 cm combined with 2 cm a
+/// step (a 1 cm bound too, but fewer pairs reused); a manifold made 5 mm wider instead of a
+/// step limit (more speculative points to carry).
+pub(crate) const RECYCLE_DISTANCE: f32 = 3.0 * LINEAR_SLOP;
+
+/// [`RECYCLE_DISTANCE`] for a pair with a rounded shape (circle, capsule, rounded polygon:
+/// `Contact::rolling_radius` > 0): the linear slop (5 mm). Its contact point rolls over the
+/// round feature instead of staying a material point, so reuse errs by R (1 − cos θ) for a
+/// turn θ: 6 µm for a disk of R = 0.5 m rolling on a larger body. With the 1.5 cm of
+/// polygon pairs, the rolling-resistance validation case's stopping-distance error went
+/// from 0.06 % to 0.58 % (of a ±2 % tolerance); this keeps it at its earlier value.
+pub(crate) const ROUND_RECYCLE_DISTANCE: f32 = LINEAR_SLOP;
+
+/// Largest relative motion per step [m] of a pair whose manifold is recycled (the narrow
+/// phase's guard, `dt · rel`): the speculative distance less the linear slop (1.5 cm);
+/// faster pairs are collided again. See [`RECYCLE_DISTANCE`] for the bound it keeps.
+pub(crate) const RECYCLE_STEP: f32 = SPECULATIVE_DISTANCE - LINEAR_SLOP;
 
 impl Contact {
     /// Recomputes the manifold and carries impulses and friction state over to points
@@ -346,12 +364,21 @@ impl Contact {
         let Memo::Basis(basis) = &self.memo else {
             return false;
         };
-        let limit2 = RECYCLE_DISTANCE * RECYCLE_DISTANCE;
         let rel = xf_a.inv_mul(xf_b);
         let turned = basis.rel_q.inv_mul(rel.q).s.abs() * extent;
-        if turned > RECYCLE_DISTANCE {
+        // A rounded shape's contact point is not a material point: it rolls, and its
+        // separation's error grows with the turn squared.
+        let limit = if self.rolling_radius > 0.0 {
+            ROUND_RECYCLE_DISTANCE
+        } else {
+            RECYCLE_DISTANCE
+        };
+        if turned > limit {
             return false;
         }
+        // Each point may move what the turn leaves of the distance.
+        let room = limit - turned;
+        let limit2 = room * room;
         let rel_ba = xf_b.inv_mul(xf_a);
         // Four lanes at once: B's points 0 and 1 seen from A's frame, A's points 0 and 1
         // seen from B's frame, each compared with where it was seen when the basis was
@@ -485,19 +512,22 @@ mod tests {
         let xf_b0 = Transform::new(Vec2::new(0.3, 0.499), 0.0);
         let mut c = contact();
         assert!(c.update(&ground, xf_g, &block, xf_b0, 0.02));
+        let (shift, turn) = (Vec2::new(0.0002, 0.0001), 0.01f32.to_radians());
         let moved = Transform {
-            p: Vec2::new(0.3002, 0.4991),
-            q: Rot::from_angle(0.01f32.to_radians()),
+            p: xf_b0.p + shift,
+            q: Rot::from_angle(turn),
         };
+        // How far a corner of the block (0.71 m from its centre) moved along the ground.
+        let slide = shift.x.abs() + 0.71 * turn;
         let (recycled, fresh) = recycled_and_fresh(&c, &ground, xf_g, &block, moved);
         assert_eq!(recycled.manifold.count, fresh.manifold.count);
         assert!((recycled.manifold.normal - fresh.manifold.normal).length() < 1e-6);
         for i in 0..fresh.manifold.count {
             let (r, f) = (recycled.manifold.points[i], fresh.manifold.points[i]);
             // The reference face's point is a material point of the ground, so the midpoint
-            // lags by at most half the relative slide: ≤ ½ RECYCLE_DISTANCE.
+            // lags by at most half the relative slide (and 1 µm of rounding).
             assert!(
-                (r.point - f.point).length() <= 0.5 * RECYCLE_DISTANCE,
+                (r.point - f.point).length() <= 0.5 * slide + 1e-6,
                 "{:?} vs {:?}",
                 r.point,
                 f.point
@@ -565,9 +595,11 @@ mod tests {
         assert!(!c.clone().recycle(xf_g, beyond, 2.0 * 0.5));
     }
 
-    /// A rolling disk's contact point is not a material point: after rolling 2 cm (well
-    /// under the speculative distance) the ground's point seen from the disk moved 2 cm,
-    /// so the manifold must be computed again; so must a box tipped by 0.5°.
+    /// A rolling disk's contact point is not a material point, but its material points
+    /// barely move as it rolls (0.4 mm after rolling 2 cm without slipping): its turn
+    /// refuses it (0.04 rad times a reach of 1 m, 4 cm > [`RECYCLE_DISTANCE`]), and a box
+    /// tipped by 0.5° is refused by its turn (12 mm at its reach) and its corners' motion
+    /// (6 mm) together, so both manifolds are computed again.
     #[test]
     fn rolling_or_turning_contacts_are_not_recycled() {
         let (ground, disk, xf_g) = disk_and_ground();
@@ -575,6 +607,18 @@ mod tests {
         assert!(c.update(&ground, xf_g, &disk, Transform::new(Vec2::new(0.0, 0.5), 0.0), 0.02));
         let rolled = Transform::new(Vec2::new(0.02, 0.5), -0.04);
         assert!(!c.clone().recycle(xf_g, rolled, 2.0 * 0.5));
+        // A small roll (0.01 rad: 1 cm at the reach) is within a polygon pair's limit, but
+        // not within a rounded shape's (`Contact::rolling_radius` > 0), whose point rolls.
+        let small = Transform::new(Vec2::new(0.005, 0.5), -0.01);
+        assert!(c.clone().recycle(xf_g, small, 2.0 * 0.5));
+        let round = Contact {
+            rolling_radius: 0.5,
+            ..c.clone()
+        };
+        assert!(!round.clone().recycle(xf_g, small, 2.0 * 0.5));
+        assert!(round
+            .clone()
+            .recycle(xf_g, Transform::new(Vec2::new(0.002, 0.5), -0.004), 2.0 * 0.5));
         let block = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
         let mut b = contact();
         assert!(b.update(&ground, xf_g, &block, Transform::new(Vec2::new(0.0, 0.5), 0.0), 0.02));

@@ -8,12 +8,12 @@
 
 use super::{ContactBeginEvent, ContactEndEvent, ShapeBounds, Stopwatch, World};
 use crate::collision::broad_phase::{MOVING_TREE, STATIC_TREE};
-use crate::collision::contact::{pair_key, Contact, Memo, NarrowOutcome, PointState, NO_COLOUR, RECYCLE_DISTANCE};
+use crate::collision::contact::{pair_key, Contact, Memo, NarrowOutcome, PointState, NO_COLOUR, RECYCLE_STEP};
 use crate::dynamics::body::Body;
 use crate::dynamics::shape::ShapeRecord;
 use crate::dynamics::{mix, BodyType};
 use crate::error::{Error, Result};
-use crate::geometry::{Manifold, Shape, LINEAR_SLOP, SPECULATIVE_DISTANCE};
+use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
 use crate::solver::contact_set::{Candidate, Candidates, ColourKey};
 use crate::solver::{
@@ -1073,6 +1073,7 @@ impl World {
         // finds whether one has while it writes the timers: a pile that keeps moving, like
         // the tumbler's, pays nothing here).
         let tts = self.def.time_to_sleep;
+        // And only every `SLEEP_CHECK_STEPS` steps.
         if !self.any_rested || self.step_count % SLEEP_CHECK_STEPS != 0 {
             return;
         }
@@ -1468,11 +1469,11 @@ fn narrow_phase(
     // A recycled manifold keeps its points, not the speculative ones a margin grown by the
     // pair's motion would add (a corner swinging towards a wall), so only a slow pair may
     // keep it: a feature it lacks was further than the speculative distance when it was
-    // made, so more than that less the recycle distance now, and closes by at most
-    // dt · rel in the step; with dt · rel ≤ speculative distance + linear slop − recycle
-    // distance it can overlap by the linear slop at most. Faster pairs are collided again
-    // (Box2D's fast bodies bypass recycling too).
-    let slow = dt * rel <= SPECULATIVE_DISTANCE + LINEAR_SLOP - RECYCLE_DISTANCE;
+    // made, has moved by at most the recycle distance since, and closes by at most dt · rel
+    // in the step; with dt · rel ≤ `RECYCLE_STEP` it can overlap by 1 cm at most
+    // (`RECYCLE_DISTANCE`). Faster pairs are collided again (Box2D's fast bodies bypass
+    // recycling too).
+    let slow = dt * rel <= RECYCLE_STEP;
     let now = (slow && c.recycle(ba.xf, bb.xf, 2.0 * ba.max_extent.min(bb.max_extent)))
         || match (shapes.at(c.shape_a.index), shapes.at(c.shape_b.index)) {
             (Some(sa), Some(sb)) => {
