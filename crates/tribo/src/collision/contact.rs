@@ -226,8 +226,8 @@ impl RecycleBasis {
 /// slop (5 cm, also motion plus turn times extent), keeping the anchors as they were.
 /// History: 1 mm (resting pairs only) until 2026-12; then 5 mm, which cut the manifolds
 /// computed per step by 42 % in Box2D's washer, 36 % in its tumbler, 34 % in junkyard and
-/// 17 % in smash; then this (instructions over 300 steps against 5 mm: junkyard −1.7 %,
-/// tumbler −2.4 %, smash −2.8 %; most of the slow pairs that still failed the 5 mm tests
+/// 17 % in smash; then this (instructions over 300 steps against 5 mm: junkyard −1.6 %,
+/// tumbler −2.4 %, smash −2.7 %; most of the slow pairs that still failed the 5 mm tests
 /// had moved 5–15 mm). Tried and dropped: 1 cm of point motion and 1 cm of turn tested
 /// apart (as fast, but a missed feature could overlap by 1.5 cm); 1 cm combined with 2 cm a
 /// step (a 1 cm bound too, but fewer pairs reused); a manifold made 5 mm wider instead of a
