@@ -136,9 +136,10 @@ pub(crate) enum Memo {
     Basis(RecycleBasis),
     /// A touching pair's poses when its manifold was computed, from which
     /// [`Contact::recycle`] makes the [`Memo::Basis`] the first time it tries to reuse the
-    /// manifold. A pair too fast to be recycled (more than [`RECYCLE_STEP`] a step) is collided again without trying, so it never needs one: in smash, junkyard and the tumbler
-    /// most full collisions are of such pairs, and making the basis each time was a tenth
-    /// of a full collision's instructions.
+    /// manifold. A pair too fast to be recycled (more than [`RECYCLE_STEP`] a step) is
+    /// collided again without trying, so it never needs one: in smash, junkyard and the
+    /// tumbler most full collisions are of such pairs, and making the basis each time was a
+    /// tenth of a full collision's instructions.
     Posed { xf_a: Transform, xf_b: Transform },
     /// A pair found apart: a lower bound [m] (> 0) on its surfaces' distance at the poses
     /// `poses` ([`Contact::still_apart`]).
