@@ -721,7 +721,7 @@ impl ContactSolver {
                 let (group, lane) = (at / LANES as u32, at % LANES as u32);
                 debug_assert!((group as usize) < lane_candidates.len(), "lane {at} past the layout");
                 if let Some(lanes) = lane_candidates.get_mut(group as usize) {
-                    lanes[lane as usize % LANES] = i as u32;
+                    lanes[lane as usize] = i as u32;
                 }
                 let slot = Slot::Wide {
                     group,
