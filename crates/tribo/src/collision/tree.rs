@@ -272,7 +272,8 @@ impl DynamicTree {
             return true;
         }
         let p = &self.nodes[parent as usize];
-        let sibling = if p.child1 == proxy { p.child2 } else { p.child1 };
+        // The parent's other child (`proxy` is one of the two: no branch on which).
+        let sibling = p.child1 ^ p.child2 ^ proxy;
         // Near: within the proxy's own size of its sibling's box. Neighbours of a sparse
         // lattice (Box2D's joint grid: circles 0.8 m wide, 1 m apart; the scaling rain:
         // boxes 0.5 m wide, 1 m apart) do not overlap but are still each other's best
@@ -291,7 +292,7 @@ impl DynamicTree {
         while i != NULL_NODE {
             let before = self.nodes[i as usize].aabb;
             self.refit(i);
-            if self.nodes[i as usize].aabb == before {
+            if self.nodes[i as usize].aabb.same(before) {
                 break; // every further ancestor is unchanged too
             }
             i = self.nodes[i as usize].parent;

@@ -386,7 +386,15 @@ impl Aabb {
     /// True when the boxes overlap (touching counts).
     #[inline]
     pub fn overlaps(self, o: Aabb) -> bool {
-        !(o.min.x > self.max.x || o.min.y > self.max.y || self.min.x > o.max.x || self.min.y > o.max.y)
+        // Bitwise, not short-circuit: one branch on the answer, not up to four.
+        !((o.min.x > self.max.x) | (o.min.y > self.max.y) | (self.min.x > o.max.x) | (self.min.y > o.max.y))
+    }
+
+    /// True when both boxes have the same corners (`==` without its short-circuit
+    /// branches).
+    #[inline]
+    pub(crate) fn same(self, o: Aabb) -> bool {
+        (self.min.x == o.min.x) & (self.min.y == o.min.y) & (self.max.x == o.max.x) & (self.max.y == o.max.y)
     }
 
     /// Perimeter [m], the surface-area heuristic's cost in 2D.
