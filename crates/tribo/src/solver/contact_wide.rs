@@ -899,17 +899,17 @@ pub(crate) fn build_group<S: StateRead>(
     (out.total_tangent_impulse, out.saturated) = (zero, M4::default());
     // Summed as `pack_state` sums (`Iterator::sum` of f32 starts at −0.0, and −0.0 + x is
     // x: the same bits, the same sign of a zero sum), without a loop; +0.0 in an empty lane.
-    hd.tangent_impulse = present.select(
-        each(&|input, _| {
-            let t = |i: usize| if warm { input.points[i].tangent_impulse } else { 0.0 };
-            match count_of(input) {
-                0 => -0.0,
-                1 => t(0),
-                _ => t(0) + t(1),
-            }
-        }),
-        zero,
-    );
+    // Four lanes at once (a `match` on each lane's count was a branch per lane).
+    let t = |i: usize| {
+        if warm {
+            each(&|input, _| input.points[i].tangent_impulse)
+        } else {
+            zero
+        }
+    };
+    let (t0, t1) = (t(0), t(1));
+    let summed = has[1].select(t0 + t1, has[0].select(t0, F4::splat(-0.0)));
+    hd.tangent_impulse = present.select(summed, zero);
     c.base_drift = base_drift.map(|d| *d);
     let [mu_s, mu_d, restitution, threshold] = columns(&|input, _| input.material_row());
     (c.mu_s, c.mu_d, c.restitution, c.restitution_threshold) = (*mu_s, *mu_d, *restitution, *threshold);
