@@ -273,6 +273,7 @@ impl DynamicTree {
         }
         let p = &self.nodes[parent as usize];
         // The parent's other child (`proxy` is one of the two: no branch on which).
+        debug_assert!(p.child1 == proxy || p.child2 == proxy, "a leaf's parent lists it");
         let sibling = p.child1 ^ p.child2 ^ proxy;
         // Near: within the proxy's own size of its sibling's box. Neighbours of a sparse
         // lattice (Box2D's joint grid: circles 0.8 m wide, 1 m apart; the scaling rain:

@@ -390,8 +390,8 @@ impl Aabb {
         !((o.min.x > self.max.x) | (o.min.y > self.max.y) | (self.min.x > o.max.x) | (self.min.y > o.max.y))
     }
 
-    /// True when both boxes have the same corners (`==` without its short-circuit
-    /// branches).
+    /// True when both boxes have the same corners: IEEE `==` on each coordinate (±0.0 equal,
+    /// NaN unequal), as the derived `==`, without its short-circuit branches.
     #[inline]
     pub(crate) fn same(self, o: Aabb) -> bool {
         (self.min.x == o.min.x) & (self.min.y == o.min.y) & (self.max.x == o.max.x) & (self.max.y == o.max.y)

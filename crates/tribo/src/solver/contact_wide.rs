@@ -862,9 +862,9 @@ pub(crate) fn build_group<S: StateRead>(
         x: has[i].select(point_rows[i][0], zero),
         y: has[i].select(point_rows[i][1], zero),
     });
-    // A sticking point's drift carries over (not a fresh one's). Chosen by masks, not a
-    // branch per lane: which points stick is data (the branch had missed 3 100 times a step
-    // in tumbler, 6 % of its misses).
+    // A sticking point's drift carries over (not a fresh one's). Chosen by masks, not a branch
+    // per lane: which points stick is data (the branch had missed 3 100 times a step in
+    // tumbler, 6 % of its misses).
     let base_drift: [F4; 2] = core::array::from_fn(|i| {
         let kept = has[i] & M4::from_bools(read.map(|(input, _)| input.points[i].stick & !input.points[i].fresh));
         kept.select(each(&|input, _| input.points[i].drift), zero)
@@ -882,7 +882,7 @@ pub(crate) fn build_group<S: StateRead>(
         } else {
             zero
         };
-        // (A mask, not a branch per lane: whether a lane has its second point is data.)
+        // (A mask, not a branch per lane: whether a lane has point `i` is data.)
         wp.preload = if warm {
             has[i].select(each(&|input, _| input.points[i].preload), zero)
         } else {
