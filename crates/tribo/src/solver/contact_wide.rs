@@ -900,14 +900,14 @@ pub(crate) fn build_group<S: StateRead>(
     // Summed as `pack_state` sums (`Iterator::sum` of f32 starts at −0.0, and −0.0 + x is
     // x: the same bits, the same sign of a zero sum), without a loop; +0.0 in an empty lane.
     // Four lanes at once (a `match` on each lane's count was a branch per lane).
-    let t = |i: usize| {
+    let friction_impulse = |i: usize| {
         if warm {
             each(&|input, _| input.points[i].tangent_impulse)
         } else {
             zero
         }
     };
-    let (t0, t1) = (t(0), t(1));
+    let (t0, t1) = (friction_impulse(0), friction_impulse(1));
     let summed = has[1].select(t0 + t1, has[0].select(t0, F4::splat(-0.0)));
     hd.tangent_impulse = present.select(summed, zero);
     c.base_drift = base_drift.map(|d| *d);
