@@ -118,9 +118,9 @@ const _: () = assert!(core::mem::size_of::<Contact>() == 320);
 
 /// What a contact keeps of its last full collision to skip the next: for a touching pair
 /// its poses then, which its first recycle turns into the recycling basis, or the distance
-/// bound of a pair found apart. A contact is one or
-/// the other, never both, so the two share their bytes: the record is five cache lines,
-/// not six (the narrow phase streams every awake contact each step).
+/// bound of a pair found apart. A contact is one or the other, never both, so they share
+/// their bytes: the record is five cache lines, not six (the narrow phase streams every
+/// awake contact each step).
 ///
 /// `repr(u8)`: a tag of one byte leaves fewer spare values than `Contact::touching`, so
 /// `Option<Contact>` keeps its `None` in that first byte; with a wider tag the compiler put

@@ -1056,9 +1056,9 @@ fn write_stored(c: &mut Contact, count: u8, rolling_impulse: f32, set: impl Fn(u
 
 /// The store stage for four constraints, in group order: exactly what
 /// `contact_solver::store_impulses` computes for each lane (the end-of-step slip velocity
-/// and the displacement along the tangent four lanes at a time, the sums and the stick/slip transitions
-/// lane by lane), transposed into each lane's rows for the contacts to take in contact
-/// order ([`StoredGroup::write_into`]).
+/// and the displacement along the tangent four lanes at a time, the sums and the stick/slip
+/// transitions lane by lane), transposed into each lane's rows for the contacts to take in
+/// contact order ([`StoredGroup::write_into`]).
 pub(crate) fn store_group<S: StateRead>(
     h: &WideHead,
     w: &WideContact,
