@@ -733,6 +733,11 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
         (zero, one, zero)
     };
     let bias_rate = rows.0;
+    // The friction row's frame: its arms' moments and the displacement along the tangent
+    // read only the step motion (d, the shift, sin Δθ), which the normal rows do not change.
+    // Made before them, so what it needs of the step motion is dead across them.
+    let t = n.right_perp();
+    let (m, disp) = RowFrame::new(h, d, shift, t).point_of(&a, &b, dv.fr_moments);
 
     // Normal rows; groups of single points skip the second point and the block.
     let (new0, new1) = if h.two_points.any() {
@@ -753,8 +758,6 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     }
 
     // Friction row (contact_solver::solve_friction).
-    let t = n.right_perp();
-    let (m, disp) = RowFrame::new(h, d, shift, t).point_of(&a, &b, dv.fr_moments);
     let limit = c.mu * (new0 + new1);
     let vt = row_speed(&a, &b, t, m) - c.tangent_speed;
     let fbias = if USE_BIAS {
