@@ -158,8 +158,8 @@ pub(crate) struct WideCold {
 
 /// What every pass of a step would derive again from a group's [`WideHead`] and
 /// [`WideContact`], made once a step ([`WideDerived::new`]) and kept in an array of its own: the
-/// moments of the friction row's anchors and K⁻¹ = [k22, −k12; −k12, k11] / det K (zero where the
-/// block does not apply). Only the passes read it; the build writes it and the store does
+/// moments of the friction row's anchors and of each point's anchors about the normal, and
+/// K⁻¹ = [k22, −k12; −k12, k11] / det K (zero where the block does not apply). Only the passes read it; the build writes it and the store does
 /// not touch it, so neither streams it with the groups. (Kept inside [`WideContact`] it
 /// made large_pyramid's step 2.5 % faster but many_pyramids' 3 % slower: its build and
 /// store streamed the bigger records.)
@@ -169,18 +169,24 @@ pub(crate) struct WideDerived {
     /// (fr_a × t, fr_b × t) [m] (what the passes' [`RowFrame`] needs of them: 32 bytes
     /// instead of the anchors' 64, and two cross products a pass fewer).
     pub fr_moments: (F4, F4),
+    /// Each point's anchors' moments about the normal, (r_a × n, r_b × n) [m] (the normal
+    /// rows' [`RowFrame::point`] of them: the arms' four coordinates are not loaded and
+    /// two cross products a point and pass fewer; zero for an absent point).
+    pub normal_moments: [(F4, F4); 2],
     pub i11: F4,
     pub i12: F4,
     pub i22: F4,
 }
 
 impl WideDerived {
-    /// From the group's friction anchors ([`friction_arms`]), tangent `t` and its K and
-    /// 1/det K: the expressions the passes evaluated each time, so the same bits.
+    /// From the group's friction anchors ([`friction_arms`]), tangent `t`, its points'
+    /// anchors and normal (in `h`) and its K and 1/det K: the expressions the passes
+    /// evaluated each time, so the same bits.
     #[inline(always)]
-    fn new(friction: (V4, V4), t: V4, w: &WideContact) -> WideDerived {
+    fn new(friction: (V4, V4), t: V4, h: &WideHead, w: &WideContact) -> WideDerived {
         WideDerived {
             fr_moments: moments(friction, t),
+            normal_moments: h.points.map(|p| moments((p.r_a, p.r_b), h.normal)),
             i11: w.k22 * w.inv_det,
             i12: -w.k12 * w.inv_det,
             i22: w.k11 * w.inv_det,
@@ -189,7 +195,7 @@ impl WideDerived {
 }
 
 // What the hot passes stream per group of four constraints (bytes).
-const _: () = assert!(core::mem::size_of::<WideDerived>() == 80);
+const _: () = assert!(core::mem::size_of::<WideDerived>() == 144);
 const _: () = assert!(core::mem::size_of::<WideContact>() == 400);
 const _: () = assert!(core::mem::size_of::<WideHead>() == 416);
 
@@ -602,8 +608,8 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
     let mut ms = [zero; 2];
     let mut is = [zero; 2];
     for i in 0..POINTS {
-        let (hp, p) = (&h.points[i], &c.points[i]);
-        let (m, disp) = frame.point(a, b, hp.r_a, hp.r_b);
+        let p = &c.points[i];
+        let (m, disp) = frame.point_of(a, b, dv.normal_moments[i]);
         rn[i] = m;
         let s = disp + p.base_separation;
         let speculative = s.gt(zero);
@@ -1011,7 +1017,7 @@ pub(crate) fn build_group<S: StateRead>(
     out.k12 = block.select(k12, zero);
     out.k22 = block.select(k22, zero);
     out.inv_det = block.select(inv, zero);
-    *derived = WideDerived::new((fr_a, fr_b), t, out);
+    *derived = WideDerived::new((fr_a, fr_b), t, hd, out);
 }
 
 /// `contact_solver::shift_cap2` four lanes at once (the same quotients and minimum; the
@@ -1330,7 +1336,7 @@ pub(crate) fn pack(
     w.mu[l] = if stick { cc.mu_s } else { cc.mu_d };
     h.two_points[l] = if cc.count == 2 { u32::MAX } else { 0 };
     pack_state(h, w, l, cc);
-    *derived = WideDerived::new(friction_arms(h), h.normal.right_perp(), w);
+    *derived = WideDerived::new(friction_arms(h), h.normal.right_perp(), h, w);
 }
 
 /// Copies the parts of a constraint that change during the substeps into lane `l`.
