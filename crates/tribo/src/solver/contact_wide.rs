@@ -403,11 +403,22 @@ fn lane_softness(h: &WideHead, soft: &StepSoftness) -> (F4, F4, F4) {
 /// speed; the only reader, so a group without restitution skips it: large_pyramid's warm
 /// start went from 0.305 to 0.279 ms per step).
 pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
+    let n = c.normal;
+    let t = n.right_perp();
+    // Both points' impulses P_i = λn_i n + λt_i t at once: the bodies take their sum P and
+    // its moments Σ r_i × P_i, the shifted arms' r_a + σ s and r_b − (1 − σ) s
+    // (`lever_arms`) adding σ (s × P) and −(1 − σ)(s × P); the arms themselves are never
+    // formed (large_pyramid: 274 → 256 instructions a group and substep, warm start
+    // 0.183 → 0.169 ms a step). What does not depend on the bodies is made before they are
+    // gathered, while few registers are taken.
+    let [p0, p1] =
+        [0, 1].map(|i| n.scale(c.points[i].normal_impulse) + t.scale(c.tangent_impulse * tangent_share(c, i)));
+    let total = p0 + p1;
+    let arms_a = c.points[0].r_a.cross(p0) + c.points[1].r_a.cross(p1);
+    let arms_b = c.points[0].r_b.cross(p0) + c.points[1].r_b.cross(p1);
     let mut a = gather(states, &c.index_a);
     let mut b = gather(states, &c.index_b);
     let shift = capped_shift(c, b.dp - a.dp);
-    let n = c.normal;
-    let t = n.right_perp();
     if c.any_restitution {
         for i in 0..2 {
             let p = &c.points[i];
@@ -415,17 +426,9 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
             c.points[i].substep_vn = relative_velocity(&a, &b, r_a, r_b).dot(n);
         }
     }
-    // Both points' impulses P_i = λn_i n + λt_i t at once: the bodies take their sum P and
-    // its moments Σ r_i × P_i, the shifted arms' r_a + σ s and r_b − (1 − σ) s
-    // (`lever_arms`) adding σ (s × P) and −(1 − σ)(s × P); the arms themselves are never
-    // formed (large_pyramid: 274 → 256 instructions a group and substep, warm start
-    // 0.183 → 0.169 ms a step).
-    let [p0, p1] =
-        [0, 1].map(|i| n.scale(c.points[i].normal_impulse) + t.scale(c.tangent_impulse * tangent_share(c, i)));
-    let total = p0 + p1;
     let turn = shift.cross(total);
-    let moment_a = c.points[0].r_a.cross(p0) + c.points[1].r_a.cross(p1) + c.split * turn;
-    let moment_b = c.points[0].r_b.cross(p0) + c.points[1].r_b.cross(p1) - (F4::splat(1.0) - c.split) * turn;
+    let moment_a = arms_a + c.split * turn;
+    let moment_b = arms_b - (F4::splat(1.0) - c.split) * turn;
     a.v = a.v - total.scale(c.inv_mass_a);
     a.w -= c.inv_i_a * moment_a;
     b.v = b.v + total.scale(c.inv_mass_b);
