@@ -553,6 +553,9 @@ fn sort_top_down(subset: &mut [ContactConstraint]) {
         .iter()
         .filter_map(|&(_, _, i)| subset.get(i as usize).copied())
         .collect();
+    // Always equal (`order` is a permutation of the indices); the test keeps
+    // `copy_from_slice` from panicking should that ever change.
+    debug_assert_eq!(sorted.len(), subset.len());
     if sorted.len() == subset.len() {
         subset.copy_from_slice(&sorted);
     }

@@ -112,9 +112,9 @@ pub(crate) struct WideHead {
 /// What costs a few instructions to derive is not stored here (the build writes these
 /// records and the store reads them: every step streams them): the softness (from whether
 /// a side is static), 1/k11 and 1/k22 (the points' normal masses where the block applies)
-/// and the rolling mass (from the inverse inertias) are derived where they are used; K⁻¹
-/// and the moments of the friction row's anchors, which every pass would derive, are in
-/// the group's [`WideDerived`]. 400 bytes (was 608). [`build_group`] writes every field (see
+/// and the rolling mass (from the inverse inertias) are derived where they are used; K⁻¹,
+/// the moments of the friction row's anchors and those of each point's anchors about the
+/// normal, which every pass would derive, are in the group's [`WideDerived`]. 400 bytes (was 608). [`build_group`] writes every field (see
 /// [`WideHead`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WideContact {
@@ -159,8 +159,9 @@ pub(crate) struct WideCold {
 /// What every pass of a step would derive again from a group's [`WideHead`] and
 /// [`WideContact`], made once a step ([`WideDerived::new`]) and kept in an array of its own: the
 /// moments of the friction row's anchors and of each point's anchors about the normal, and
-/// K⁻¹ = [k22, −k12; −k12, k11] / det K (zero where the block does not apply). Only the passes read it; the build writes it and the store does
-/// not touch it, so neither streams it with the groups. (Kept inside [`WideContact`] it
+/// K⁻¹ = [k22, −k12; −k12, k11] / det K (zero where the block does not apply). Only the
+/// passes and restitution read it; the build (or [`pack`]) writes it and the store does not
+/// touch it, so the store does not stream it with the groups. (Kept inside [`WideContact`] it
 /// made large_pyramid's step 2.5 % faster but many_pyramids' 3 % slower: its build and
 /// store streamed the bigger records.)
 #[derive(Clone, Copy, Debug, Default)]
@@ -169,9 +170,10 @@ pub(crate) struct WideDerived {
     /// (fr_a × t, fr_b × t) [m] (what the passes' [`RowFrame`] needs of them: 32 bytes
     /// instead of the anchors' 64, and two cross products a pass fewer).
     pub fr_moments: (F4, F4),
-    /// Each point's anchors' moments about the normal, (r_a × n, r_b × n) [m] (the normal
-    /// rows' [`RowFrame::point`] of them: the arms' four coordinates are not loaded and
-    /// two cross products a point and pass fewer; zero for an absent point).
+    /// Each point's anchors' moments about the normal, (r_a × n, r_b × n) [m]: what
+    /// [`RowFrame::point`] derived from the anchors in each pass, now read through
+    /// [`RowFrame::point_of`] (the arms' four coordinates are not loaded, and two cross
+    /// products a point and pass fewer; ±0 for an absent point).
     pub normal_moments: [(F4, F4); 2],
     pub i11: F4,
     pub i12: F4,
@@ -604,7 +606,8 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
     let one = F4::splat(1.0);
     let push = F4::splat(ctx.push_speed);
     let frame = RowFrame::new(h, d, shift, n);
-    // Each point's arm moments about the normal (`RowFrame::point`).
+    // Each point's arm moments about the normal (`WideDerived::normal_moments`, through
+    // `RowFrame::point_of`).
     let mut rn = [(zero, zero); 2];
     let mut vn = [zero; 2];
     let mut bias = [zero; 2];
@@ -1599,6 +1602,7 @@ mod tests {
         let (mut rh, mut r, mut rcold) = (h, w, cold);
         let mut rdv = WideDerived {
             i12: F4::splat(7.0),
+            normal_moments: [(F4::splat(7.0), F4::splat(7.0)); 2],
             ..dv
         };
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
@@ -1622,7 +1626,8 @@ mod tests {
         // The ready-made part, lane by lane from the scalar build: the moments of the
         // friction row's anchors, at the middle of two points (at the point of one), K⁻¹
         // from the block's K and 1/det K (zeros, the middle one −0, where the block does
-        // not apply), to the bit.
+        // not apply), each point's anchors' moments about the normal (zero arms for an
+        // absent point), to the bit.
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
             let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
             let [p0, p1] = &cc.points;
@@ -1634,6 +1639,14 @@ mod tests {
             let expected = [fr_a.cross(t), fr_b.cross(t), k22 * inv, -k12 * inv, k11 * inv];
             let lane = [dv.fr_moments.0, dv.fr_moments.1, dv.i11, dv.i12, dv.i22].map(|x| x[l]);
             assert_eq!(lane.map(f32::to_bits), expected.map(f32::to_bits), "lane {l}");
+            let arm = |i: usize, r: Vec2| if i < cc.count { r } else { Vec2::ZERO };
+            let expected: Vec<f32> = (0..2)
+                .flat_map(|i| [arm(i, cc.points[i].r_a), arm(i, cc.points[i].r_b)])
+                .map(|r| r.cross(cc.normal))
+                .collect();
+            let lane: Vec<f32> = dv.normal_moments.iter().flat_map(|m| [m.0[l], m.1[l]]).collect();
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&lane), bits(&expected), "lane {l}: moments about the normal");
         }
         // What the lanes derive instead of storing (softness, K⁻¹, rolling mass, friction
         // coefficient) comes back as the scalar build made it.
