@@ -553,7 +553,7 @@ fn sort_top_down(subset: &mut [ContactConstraint]) {
         .iter()
         .filter_map(|&(_, _, i)| subset.get(i as usize).copied())
         .collect();
-    // Always equal (`order` is a permutation of the indices); the test keeps
+    // Always equal (`order` is a permutation of the indices); the `if` keeps
     // `copy_from_slice` from panicking should that ever change.
     debug_assert_eq!(sorted.len(), subset.len());
     if sorted.len() == subset.len() {
