@@ -365,6 +365,22 @@ impl F4 {
             M4::new(lanes!(|i| mask(self[i] != o[i])))
         )
     }
+
+    /// The lanes whose bits (a word of flags carried as a float's bits, never used as a
+    /// number) have every bit of `bits` set.
+    #[inline(always)]
+    pub fn bits_set(self, bits: u32) -> M4 {
+        simd!(
+            {
+                let b = _mm_set1_epi32(bits as i32);
+                sse::to_m(_mm_castsi128_ps(_mm_cmpeq_epi32(
+                    _mm_and_si128(_mm_castps_si128(sse::f(self)), b),
+                    b,
+                )))
+            },
+            M4::new(lanes!(|i| mask(self[i].to_bits() & bits == bits)))
+        )
+    }
 }
 
 /// The 4×4 transpose: lane `j` of output `i` is lane `i` of input `j` (turns four bodies'
@@ -555,6 +571,18 @@ impl M4 {
                 )))
             },
             M4::new(lanes!(|i| mask(a[i] == 0 || b[i] == 0)))
+        )
+    }
+
+    /// The four lanes as booleans (from the lanes' sign bits, as `any` and `all` test).
+    #[inline(always)]
+    pub fn to_bools(self) -> [bool; LANES] {
+        simd!(
+            {
+                let bits = _mm_movemask_ps(sse::m(self));
+                [bits & 1 != 0, bits & 2 != 0, bits & 4 != 0, bits & 8 != 0]
+            },
+            lanes!(|i| self[i] != 0)
         )
     }
 

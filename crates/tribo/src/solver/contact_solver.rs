@@ -204,8 +204,11 @@ pub(crate) struct ContactInput {
     pub rolling_impulse: f32,
 }
 
-/// One manifold point and its carried-over state (see [`ContactInput`]).
+/// One manifold point and its carried-over state (see [`ContactInput`]). Laid out as two
+/// rows of four words, each one row of the wide build's transposes ([`InputPoint::row`],
+/// [`InputPoint::state_row`]).
 #[derive(Clone, Copy, Debug, Default)]
+#[repr(C)]
 pub(crate) struct InputPoint {
     pub point: Vec2,
     pub separation: f32,
@@ -213,9 +216,16 @@ pub(crate) struct InputPoint {
     pub tangent_impulse: f32,
     pub preload: f32,
     pub drift: f32,
-    pub stick: bool,
-    pub fresh: bool,
+    /// [`INPUT_STICK`] and [`INPUT_FRESH`]: one word, so that the wide build reads four
+    /// lanes' flags in the transpose of their state rows and tests them four lanes at a
+    /// time, instead of assembling masks from single bytes.
+    pub flags: u32,
 }
+
+/// Flag of an [`InputPoint`]: it sticks ([`FrictionState::Stick`]).
+pub(crate) const INPUT_STICK: u32 = 1;
+/// Flag of an [`InputPoint`]: it is new this step ([`PointState::fresh`]).
+pub(crate) const INPUT_FRESH: u32 = 2;
 
 impl InputPoint {
     /// The point [m], its separation [m] and normal impulse [N·s], side by side in the
@@ -223,6 +233,36 @@ impl InputPoint {
     #[inline(always)]
     pub fn row(&self) -> [f32; 4] {
         [self.point.x, self.point.y, self.separation, self.normal_impulse]
+    }
+
+    /// The friction impulse [N·s], preload [N·s], drift [m] and the flags word (its bits
+    /// as a float's), side by side in the record: the other row.
+    #[inline(always)]
+    pub fn state_row(&self) -> [f32; 4] {
+        [
+            self.tangent_impulse,
+            self.preload,
+            self.drift,
+            f32::from_bits(self.flags),
+        ]
+    }
+
+    /// The flags word of a point that sticks or slides, new or not.
+    #[inline(always)]
+    pub fn flags_of(stick: bool, fresh: bool) -> u32 {
+        (if stick { INPUT_STICK } else { 0 }) | (if fresh { INPUT_FRESH } else { 0 })
+    }
+
+    /// Whether the point sticks.
+    #[inline(always)]
+    pub fn stick(&self) -> bool {
+        self.flags & INPUT_STICK != 0
+    }
+
+    /// Whether the point is new this step.
+    #[inline(always)]
+    pub fn fresh(&self) -> bool {
+        self.flags & INPUT_FRESH != 0
     }
 }
 
@@ -252,8 +292,7 @@ impl ContactInput {
             tangent_impulse: 0.0,
             preload: 0.0,
             drift: 0.0,
-            stick: false,
-            fresh: false,
+            flags: 0,
         }; 2],
         mu_s: 0.0,
         mu_d: 0.0,
@@ -270,7 +309,7 @@ impl ContactInput {
     /// or a speculative one, is not (tumbler: most of its new points are such).
     pub fn may_be_new_resting(&self) -> bool {
         let points = &self.points[..self.count.min(2)];
-        !points.is_empty() && points.iter().all(|p| fresh_touching(p.fresh, p.separation))
+        !points.is_empty() && points.iter().all(|p| fresh_touching(p.fresh(), p.separation))
     }
 
     /// Writes what building a constraint reads of contact `c` in place (no copy).
@@ -294,8 +333,7 @@ impl ContactInput {
                     tangent_impulse: ps.tangent_impulse,
                     preload: ps.preload,
                     drift: ps.drift,
-                    stick: ps.state == FrictionState::Stick,
-                    fresh: ps.fresh,
+                    flags: InputPoint::flags_of(ps.state == FrictionState::Stick, ps.fresh),
                 },
                 _ => InputPoint::default(),
             };
@@ -372,7 +410,7 @@ pub(crate) fn build_constraint<S: StateRead>(
         cp.r_a = r_a;
         cp.r_b = r_b;
         cp.base_separation = ps.separation;
-        cp.base_drift = if ps.stick && !ps.fresh { ps.drift } else { 0.0 };
+        cp.base_drift = if ps.stick() && !ps.fresh() { ps.drift } else { 0.0 };
         cp.normal_mass = inv_or_zero(effective_mass_inv(&masses, r_a, r_b, n));
         cp.tangent_mass = inv_or_zero(effective_mass_inv(&masses, r_a, r_b, t));
         if ctx.warm_starting {
@@ -380,8 +418,8 @@ pub(crate) fn build_constraint<S: StateRead>(
             cp.tangent_impulse = ps.tangent_impulse;
             cp.preload = ps.preload;
         }
-        cp.stick = ps.stick;
-        cp.fresh = ps.fresh;
+        cp.stick = ps.stick();
+        cp.fresh = ps.fresh();
         cp.soft = point_soft;
         if cp.fresh {
             cp.stick = fresh_point_sticks(&sa, &sb, r_a, r_b, t, cc.tangent_speed, cp.base_separation, ctx);
@@ -1495,7 +1533,7 @@ mod tests {
             points: [
                 InputPoint {
                     point,
-                    fresh: true,
+                    flags: INPUT_FRESH,
                     ..InputPoint::default()
                 },
                 InputPoint::default(),

@@ -33,7 +33,7 @@
 
 use super::contact_solver::{
     fresh_point_sticks, kinetic_energy_of, ConstraintBodies, ConstraintPoint, ContactConstraint, ContactInput,
-    StepSoftness,
+    StepSoftness, INPUT_FRESH, INPUT_STICK,
 };
 use super::wide::{transpose, F4, LANES, M4, V4};
 use super::{StateCell, StateRead, StepContext};
@@ -878,13 +878,16 @@ pub(crate) fn build_group<S: StateRead>(
         x: has[i].select(point_rows[i][0], zero),
         y: has[i].select(point_rows[i][1], zero),
     });
+    // Each point's (friction impulse, preload, drift, flags), and its flags as masks (none
+    // where the lane lacks the point): the flags come in the transpose with the floats, one
+    // word a lane, instead of masks assembled from each lane's bytes.
+    let state_rows: [[F4; 4]; 2] = core::array::from_fn(|i| columns(&|input, _| input.points[i].state_row()));
+    let stick_in: [M4; 2] = core::array::from_fn(|i| has[i] & state_rows[i][3].bits_set(INPUT_STICK));
+    let fresh: [M4; 2] = core::array::from_fn(|i| has[i] & state_rows[i][3].bits_set(INPUT_FRESH));
     // A sticking point's drift carries over (not a fresh one's). Chosen by masks, not a branch
     // per lane: which points stick is data (the branch had missed 3 100 times a step in
     // tumbler, 6 % of its misses).
-    let base_drift: [F4; 2] = core::array::from_fn(|i| {
-        let kept = has[i] & M4::from_bools(read.map(|(input, _)| input.points[i].stick & !input.points[i].fresh));
-        kept.select(each(&|input, _| input.points[i].drift), zero)
-    });
+    let base_drift: [F4; 2] = core::array::from_fn(|i| (stick_in[i] & !fresh[i]).select(state_rows[i][2], zero));
     hd.normal = V4 {
         x: each(&|input, _| input.normal.x),
         y: each(&|input, _| input.normal.y),
@@ -900,7 +903,7 @@ pub(crate) fn build_group<S: StateRead>(
         };
         // (A mask, not a branch per lane: whether a lane has point `i` is data.)
         wp.preload = if warm {
-            has[i].select(each(&|input, _| input.points[i].preload), zero)
+            has[i].select(state_rows[i][1], zero)
         } else {
             zero
         };
@@ -916,13 +919,7 @@ pub(crate) fn build_group<S: StateRead>(
     // Summed as `pack_state` sums (`Iterator::sum` of f32 starts at −0.0, and −0.0 + x is
     // x: the same bits, the same sign of a zero sum), without a loop; +0.0 in an empty lane.
     // Four lanes at once (a `match` on each lane's count was a branch per lane).
-    let friction_impulse = |i: usize| {
-        if warm {
-            each(&|input, _| input.points[i].tangent_impulse)
-        } else {
-            zero
-        }
-    };
+    let friction_impulse = |i: usize| if warm { state_rows[i][0] } else { zero };
     let (t0, t1) = (friction_impulse(0), friction_impulse(1));
     let summed = has[1].select(t0 + t1, has[0].select(t0, F4::splat(-0.0)));
     hd.tangent_impulse = present.select(summed, zero);
@@ -943,38 +940,44 @@ pub(crate) fn build_group<S: StateRead>(
     c.height = *has[0].select(height, zero);
     for (l, lane) in lanes.iter().enumerate() {
         let Some((contact, input, b)) = *lane else {
-            // An empty lane: nothing but a sticking, empty friction row.
-            out.stick[l] = u32::MAX;
             continue;
         };
-        let count = count_of(input);
         c.contact[l] = contact;
-        c.count[l] = count as u8;
-        let states_ab = input.points[..count]
-            .iter()
-            .any(|p| p.fresh)
-            .then(|| (states[b.index_a as usize].get(), states[b.index_b as usize].get()));
+        c.count[l] = count_of(input) as u8;
         if input.restitution > 0.0 {
             let (sa, sb) = (states[b.index_a as usize].get(), states[b.index_b as usize].get());
             c.kinetic_energy[l] = kinetic_energy_of(b.inv_mass_a, b.inv_i_a, b.inv_mass_b, b.inv_i_b, &sa, &sb);
         }
-        let t = input.normal.right_perp();
-        let mut row_stick = true;
-        for (i, ip) in input.points[..count].iter().enumerate() {
-            let stick = match states_ab {
-                Some((sa, sb)) if ip.fresh => {
-                    let (r_a, r_b) = (ip.point - b.center_a, ip.point - b.center_b);
-                    fresh_point_sticks(&sa, &sb, r_a, r_b, t, input.tangent_speed, ip.separation, ctx)
-                }
-                _ => ip.stick,
-            };
-            c.stick[i][l] = stick;
-            c.fresh[i][l] = ip.fresh;
-            row_stick &= stick;
-        }
-        out.stick[l] = if row_stick { u32::MAX } else { 0 };
     }
-    // μs where the row sticks (an empty lane: 0), μd where it slides.
+    // Each point's friction state: its own, but a new point's is decided from the bodies'
+    // velocities (`fresh_point_sticks`), lane by lane where a lane has one.
+    c.fresh = fresh.map(M4::to_bools);
+    let stick = if (fresh[0] | fresh[1]).any() {
+        let mut stick = stick_in.map(M4::to_bools);
+        for (l, lane) in lanes.iter().enumerate() {
+            let Some((_, input, b)) = *lane else {
+                continue;
+            };
+            if !(c.fresh[0][l] || c.fresh[1][l]) {
+                continue;
+            }
+            let (sa, sb) = (states[b.index_a as usize].get(), states[b.index_b as usize].get());
+            let t = input.normal.right_perp();
+            for (i, ip) in input.points[..count_of(input)].iter().enumerate() {
+                if ip.fresh() {
+                    let (r_a, r_b) = (ip.point - b.center_a, ip.point - b.center_b);
+                    stick[i][l] = fresh_point_sticks(&sa, &sb, r_a, r_b, t, input.tangent_speed, ip.separation, ctx);
+                }
+            }
+        }
+        stick.map(M4::from_stored_bools)
+    } else {
+        stick_in
+    };
+    c.stick = stick.map(M4::to_bools);
+    // The row sticks where every point it has sticks (an empty lane: a sticking, empty
+    // friction row). μs where the row sticks (an empty lane: 0), μd where it slides.
+    out.stick = (!has[0] | stick[0]) & (!has[1] | stick[1]);
     out.mu = out.stick.select(mu_s, mu_d);
     // Four lanes at once (contact_solver::build_constraint and pack).
     let n = hd.normal;
@@ -1491,8 +1494,7 @@ mod tests {
             tangent_impulse: -0.2 * x,
             preload: 0.5,
             drift: 1e-3 * x,
-            stick: x > 0.0,
-            fresh,
+            flags: InputPoint::flags_of(x > 0.0, fresh),
         };
         ContactInput {
             normal: Vec2::new(0.6, 0.8),

@@ -372,7 +372,11 @@ impl World {
         for list in &mut lists {
             list.get_mut().unwrap_or_else(|e| e.into_inner()).clear();
         }
-        let (shapes, solver_bodies, bounds) = (&self.shapes, &self.solver_bodies, &self.shape_bounds);
+        let (shapes, solver_bodies, bounds) = (
+            &self.shapes,
+            self.solver_bodies.as_slice(),
+            self.shape_bounds.as_slice(),
+        );
         // Updates one contact, writes its outcome and, if it is touching with an awake
         // dynamic side, its candidate.
         let update = |ci: usize,
@@ -402,7 +406,7 @@ impl World {
                 mark[ci as usize] = true;
             }
         }
-        let (flags_ref, mark_ref, lists_ref) = (&flags, &mark, &lists);
+        let (flags_ref, mark_ref, lists_ref) = (flags.as_slice(), mark.as_slice(), lists.as_slice());
         let flag = |bi: u32| flags_ref.get(bi as usize).copied().unwrap_or(false);
         // The shapes' records (their geometry) are asked for too when at least 1 in 8 of the
         // pairs were collided in full last step (a pile in motion: tumbler 15-38 %, smash
