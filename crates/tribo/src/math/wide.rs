@@ -209,6 +209,7 @@ mod sse {
         _mm_set1_epi32(a: i32) -> __m128i;
         _mm_castsi128_ps(a: __m128i) -> __m128;
         _mm_cmpeq_epi32(a: __m128i, b: __m128i) -> __m128i;
+        _mm_cmpgt_epi32(a: __m128i, b: __m128i) -> __m128i;
         _mm_or_si128(a: __m128i, b: __m128i) -> __m128i;
         _mm_and_si128(a: __m128i, b: __m128i) -> __m128i;
         _mm_setzero_si128() -> __m128i;
@@ -555,6 +556,32 @@ impl M4 {
                 !sse::to_m(_mm_castsi128_ps(zero))
             },
             M4::new(b.map(|x| mask(x != 0)))
+        )
+    }
+
+    /// The lanes where `a` is zero.
+    #[inline(always)]
+    pub fn zero_lanes(a: [u32; LANES]) -> M4 {
+        simd!(
+            sse::to_m(_mm_castsi128_ps(_mm_cmpeq_epi32(
+                _mm_setr_epi32(a[0] as i32, a[1] as i32, a[2] as i32, a[3] as i32),
+                _mm_setzero_si128(),
+            ))),
+            M4::new(lanes!(|i| mask(a[i] == 0)))
+        )
+    }
+
+    /// The lanes where `a` is greater than `k` (unsigned: both offset by 2³¹ for the
+    /// signed compare).
+    #[inline(always)]
+    pub fn above(a: [u32; LANES], k: u32) -> M4 {
+        simd!(
+            {
+                let flip = |x: u32| (x ^ 0x8000_0000) as i32;
+                let v = _mm_setr_epi32(flip(a[0]), flip(a[1]), flip(a[2]), flip(a[3]));
+                sse::to_m(_mm_castsi128_ps(_mm_cmpgt_epi32(v, _mm_set1_epi32(flip(k)))))
+            },
+            M4::new(lanes!(|i| mask(a[i] > k)))
         )
     }
 

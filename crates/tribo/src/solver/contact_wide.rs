@@ -856,8 +856,6 @@ pub(crate) fn build_group<S: StateRead>(
     // Each lane's bodies (an empty lane: the static body, not written back).
     hd.index_a = read.map(|(_, b)| b.index_a);
     hd.index_b = read.map(|(_, b)| b.index_b);
-    hd.write_a = read.map(|(_, b)| b.moving()[0]);
-    hd.write_b = read.map(|(_, b)| b.moving()[1]);
     let each = |f: &dyn Fn(&ContactInput, &ConstraintBodies) -> f32| {
         F4::new(core::array::from_fn(|l| f(read[l].0, read[l].1)))
     };
@@ -871,9 +869,15 @@ pub(crate) fn build_group<S: StateRead>(
     let [cax, cay, cbx, cby] = columns(&|_, b| b.centre_row());
     let (center_a, center_b) = (V4 { x: cax, y: cay }, V4 { x: cbx, y: cby });
     let [ma, ia, mb, ib] = columns(&|_, b| b.mass_row());
+    // Which sides are written back: `ConstraintBodies::moving`, four lanes at once from
+    // the masses' columns.
+    let moving = |m: F4, i: F4, index: [u32; LANES]| ((m.gt(zero) | i.gt(zero)) & !M4::zero_lanes(index)).to_bools();
+    hd.write_a = moving(ma, ia, hd.index_a);
+    hd.write_b = moving(mb, ib, hd.index_b);
     // Each point's (x, y, separation, normal impulse); kept where the lane has the point.
     let point_rows: [[F4; 4]; 2] = core::array::from_fn(|i| columns(&|input, _| input.points[i].row()));
-    let has: [M4; 2] = core::array::from_fn(|i| M4::from_bools(read.map(|(input, _)| i < count_of(input))));
+    let counts = read.map(|(input, _)| count_of(input) as u32);
+    let has: [M4; 2] = core::array::from_fn(|i| M4::above(counts, i as u32));
     let point: [V4; 2] = core::array::from_fn(|i| V4 {
         x: has[i].select(point_rows[i][0], zero),
         y: has[i].select(point_rows[i][1], zero),
