@@ -854,8 +854,8 @@ pub(crate) fn build_group<S: StateRead>(
     });
     let present = M4::from_bools(lanes.map(|lane| lane.is_some()));
     // Each lane's bodies (an empty lane: the static body, not written back).
-    hd.index_a = read.map(|(_, b)| b.index_a);
-    hd.index_b = read.map(|(_, b)| b.index_b);
+    let (index_a, index_b) = (read.map(|(_, b)| b.index_a), read.map(|(_, b)| b.index_b));
+    (hd.index_a, hd.index_b) = (index_a, index_b);
     let each = |f: &dyn Fn(&ContactInput, &ConstraintBodies) -> f32| {
         F4::new(core::array::from_fn(|l| f(read[l].0, read[l].1)))
     };
@@ -872,8 +872,8 @@ pub(crate) fn build_group<S: StateRead>(
     // Which sides are written back: `ConstraintBodies::moving`, four lanes at once from
     // the masses' columns.
     let moving = |m: F4, i: F4, index: [u32; LANES]| ((m.gt(zero) | i.gt(zero)) & !M4::zero_lanes(index)).to_bools();
-    hd.write_a = moving(ma, ia, hd.index_a);
-    hd.write_b = moving(mb, ib, hd.index_b);
+    hd.write_a = moving(ma, ia, index_a);
+    hd.write_b = moving(mb, ib, index_b);
     // Each point's (x, y, separation, normal impulse); kept where the lane has the point.
     let point_rows: [[F4; 4]; 2] = core::array::from_fn(|i| columns(&|input, _| input.points[i].row()));
     let counts = read.map(|(input, _)| count_of(input) as u32);
