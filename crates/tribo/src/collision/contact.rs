@@ -25,7 +25,11 @@ pub enum FrictionState {
 ///
 /// `repr(C)`, the eight floats first in the order of [`PointState::set_stored`]: the
 /// impulse store writes them as two 16-byte rows per point, straight from the transpose
-/// of its lanes.
+/// of its lanes. The first row holds what the next step's solver input reads
+/// (`ContactInput::fill`: the impulses, drift and preload), the second the step's sums,
+/// which [`Contact::recycle`] zeroes just before that read: with the sums in the first row
+/// the input's 16-byte load spanned the recycle's smaller stores and could not be
+/// forwarded from them (it waited for them to reach the cache, four times a contact).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C)]
 pub(crate) struct PointState {
@@ -33,20 +37,20 @@ pub(crate) struct PointState {
     pub normal_impulse: f32,
     /// Friction impulse of the last substep [N·s] (warm start), along the tangent.
     pub tangent_impulse: f32,
+    /// Tangential slip [m] accumulated while sticking (the static-friction anchor): the
+    /// solver drives it back to zero, so a sticking body cannot creep.
+    pub drift: f32,
+    /// Normal impulse per substep [N·s] the soft contact relaxes towards (a slowly
+    /// tracking average of the manifold's load, so a steady load needs no deflection).
+    pub preload: f32,
     /// Sum over the step's substeps of the normal impulse [N·s] (what the step applied).
     pub total_normal_impulse: f32,
     /// Sum over the step's substeps of the friction impulse [N·s].
     pub total_tangent_impulse: f32,
     /// Largest normal impulse of any substep [N·s]; > 0 means the point carried load.
     pub max_normal_impulse: f32,
-    /// Tangential slip [m] accumulated while sticking (the static-friction anchor): the
-    /// solver drives it back to zero, so a sticking body cannot creep.
-    pub drift: f32,
     /// Relative tangential speed at the end of the step [m/s] (surface speed removed).
     pub slip_speed: f32,
-    /// Normal impulse per substep [N·s] the soft contact relaxes towards (a slowly
-    /// tracking average of the manifold's load, so a steady load needs no deflection).
-    pub preload: f32,
     /// Stick or slip.
     pub state: FrictionState,
     /// True until the point has been through one solver step.
@@ -54,22 +58,22 @@ pub(crate) struct PointState {
 }
 
 impl PointState {
-    /// Sets what the impulse store writes: `impulses` = (normal, tangent, total normal,
-    /// total tangent) [N·s], `rest` = (max normal [N·s], drift [m], slip speed [m/s],
-    /// preload [N·s]), the friction state, and `fresh` off. Field by field in layout order,
-    /// so each row compiles to one 16-byte store.
+    /// Sets what the impulse store writes: `carried` = (normal [N·s], tangent [N·s], drift
+    /// [m], preload [N·s]), `sums` = (total normal [N·s], total tangent [N·s], max normal
+    /// [N·s], slip speed [m/s]), the friction state, and `fresh` off. Field by field in
+    /// layout order, so each row compiles to one 16-byte store.
     #[inline(always)]
-    pub fn set_stored(&mut self, impulses: [f32; 4], rest: [f32; 4], state: FrictionState) {
-        let [normal, tangent, total_normal, total_tangent] = impulses;
-        let [max, drift, slip_speed, preload] = rest;
+    pub fn set_stored(&mut self, carried: [f32; 4], sums: [f32; 4], state: FrictionState) {
+        let [normal, tangent, drift, preload] = carried;
+        let [total_normal, total_tangent, max, slip_speed] = sums;
         self.normal_impulse = normal;
         self.tangent_impulse = tangent;
+        self.drift = drift;
+        self.preload = preload;
         self.total_normal_impulse = total_normal;
         self.total_tangent_impulse = total_tangent;
         self.max_normal_impulse = max;
-        self.drift = drift;
         self.slip_speed = slip_speed;
-        self.preload = preload;
         self.state = state;
         self.fresh = false;
     }

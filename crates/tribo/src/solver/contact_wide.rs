@@ -1187,8 +1187,8 @@ pub(crate) struct StoredPoint {
 /// contacts ran 369 instructions a group, now 282, and the transposes, two shuffles a row,
 /// add 62 to `store_group`).
 pub(crate) struct StoredGroup {
-    /// `rows[l][i]`: point `i` of lane `l`, (normal, tangent, total normal, total
-    /// tangent) and (max normal, drift, slip speed, preload).
+    /// `rows[l][i]`: point `i` of lane `l`, (normal, tangent, drift, preload) and (total
+    /// normal, total tangent, max normal, slip speed).
     rows: [[[F4; 2]; 2]; LANES],
     /// Each point's friction state, lanes (set: stick).
     stick: [M4; 2],
@@ -1204,8 +1204,8 @@ impl StoredGroup {
     fn new(points: [StoredPoint; 2], tangent: F4, rolling_impulse: F4, count: [u8; LANES]) -> StoredGroup {
         let rows_of = |p: &StoredPoint| {
             (
-                transpose([p.normal, tangent, p.total_normal, p.total_tangent]),
-                transpose([p.max, p.drift, p.slip_speed, p.preload]),
+                transpose([p.normal, tangent, p.drift, p.preload]),
+                transpose([p.total_normal, p.total_tangent, p.max, p.slip_speed]),
             )
         };
         let ((a0, b0), (a1, b1)) = (rows_of(&points[0]), rows_of(&points[1]));
