@@ -304,7 +304,17 @@ impl Contact {
             };
             return false;
         }
-        self.memo = Memo::Posed { xf_a, xf_b };
+        // The variant set first and its poses written in place: assigned whole, the
+        // compiler built it on the stack and copied it from one byte in, a 16-byte load
+        // over a 16-byte store it only half overlapped (no forwarding: a stall per full
+        // collision).
+        self.memo = Memo::Posed {
+            xf_a: Transform::IDENTITY,
+            xf_b: Transform::IDENTITY,
+        };
+        if let Memo::Posed { xf_a: a, xf_b: b } = &mut self.memo {
+            (*a, *b) = (xf_a, xf_b);
+        }
         true
     }
 
