@@ -1190,8 +1190,10 @@ pub(crate) struct StoredGroup {
     /// `rows[l][i]`: point `i` of lane `l`, (normal, tangent, drift, preload) and (total
     /// normal, total tangent, max normal, slip speed).
     rows: [[[F4; 2]; 2]; LANES],
-    /// Each point's friction state, lanes (set: stick).
-    stick: [M4; 2],
+    /// Each point's friction state, lane by lane (true: stick; as booleans, not masks: the
+    /// writes read one lane at a time, and a mask's lane was copied out of it through the
+    /// stack at every read).
+    stick: [[bool; LANES]; 2],
     rolling_impulse: F4,
     /// The manifolds' point counts.
     count: [u8; LANES],
@@ -1211,7 +1213,7 @@ impl StoredGroup {
         let ((a0, b0), (a1, b1)) = (rows_of(&points[0]), rows_of(&points[1]));
         StoredGroup {
             rows: core::array::from_fn(|l| [[a0[l], b0[l]], [a1[l], b1[l]]]),
-            stick: [points[0].stick, points[1].stick],
+            stick: [points[0].stick.to_bools(), points[1].stick.to_bools()],
             rolling_impulse,
             count,
         }
@@ -1221,7 +1223,7 @@ impl StoredGroup {
     #[inline(always)]
     fn set_point(&self, i: usize, l: usize, ps: &mut PointState) {
         let [a, b] = &self.rows[l][i];
-        let state = if self.stick[i].lane(l) {
+        let state = if self.stick[i][l] {
             FrictionState::Stick
         } else {
             FrictionState::Slip
