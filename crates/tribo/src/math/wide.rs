@@ -601,7 +601,7 @@ impl M4 {
         )
     }
 
-    /// The four lanes as booleans (from the lanes' sign bits, as `any` and `all` test).
+    /// The four lanes of a mask (each lane all ones or all zeros) as booleans.
     #[inline(always)]
     pub fn to_bools(self) -> [bool; LANES] {
         simd!(
@@ -866,5 +866,23 @@ mod tests {
         let (ia, ib) = ([0, 7, 3, u32::MAX], [5, 0, 9, 1]);
         assert_eq!(*M4::either_zero(ia, ib), [u32::MAX, u32::MAX, 0, 0]);
         assert_eq!(*M4::either_zero([0; LANES], [0; LANES]), [u32::MAX; LANES]);
+        assert_eq!(*M4::zero_lanes([0, u32::MAX, 1, 0]), [u32::MAX, 0, 0, u32::MAX]);
+        // `above` compares unsigned words (the signed compare's 2³¹ offset): the largest
+        // word is above everything, and words either side of 2³¹ keep their order.
+        let on = u32::MAX;
+        assert_eq!(*M4::above([0, 1, 2, u32::MAX], 1), [0, 0, on, on]);
+        assert_eq!(
+            *M4::above([0x8000_0000, 0x7fff_ffff, 0, 0x8000_0001], 0x7fff_ffff),
+            [on, 0, 0, on]
+        );
+        assert_eq!(*M4::above([0x8000_0000, u32::MAX, 5, 0], 0x8000_0000), [0, on, 0, 0]);
+        // Flag words carried as float bits, never as numbers: a NaN's bits, a negative
+        // zero's, all ones; every bit asked for must be set.
+        let words = F4::new([0xffff_ffff, 0x8000_0002, 0x7fc0_0001, 0x0000_0001].map(f32::from_bits));
+        assert_eq!(*words.bits_set(1), [on, 0, on, on]);
+        assert_eq!(*words.bits_set(2), [on, on, 0, 0]);
+        assert_eq!(*words.bits_set(3), [on, 0, 0, 0]);
+        assert_eq!(m.to_bools(), [true, false, false, true]);
+        assert_eq!((!m).to_bools(), [false, true, true, false]);
     }
 }

@@ -224,7 +224,8 @@ pub(crate) struct InputPoint {
 
 /// Flag of an [`InputPoint`]: it sticks ([`FrictionState::Stick`]).
 pub(crate) const INPUT_STICK: u32 = 1;
-/// Flag of an [`InputPoint`]: it is new this step ([`PointState::fresh`]).
+/// Flag of an [`InputPoint`]: it is new this step
+/// ([`PointState::fresh`](crate::collision::contact::PointState::fresh)).
 pub(crate) const INPUT_FRESH: u32 = 2;
 
 impl InputPoint {

@@ -974,11 +974,12 @@ pub(crate) fn build_group<S: StateRead>(
                 }
             }
         }
+        c.stick = stick;
         stick.map(M4::from_stored_bools)
     } else {
+        c.stick = stick_in.map(M4::to_bools);
         stick_in
     };
-    c.stick = stick.map(M4::to_bools);
     // The row sticks where every point it has sticks (an empty lane: a sticking, empty
     // friction row). μs where the row sticks (an empty lane: 0), μd where it slides.
     out.stick = (!has[0] | stick[0]) & (!has[1] | stick[1]);
@@ -1601,11 +1602,15 @@ mod tests {
         }
     }
 
-    #[test]
-    fn wide_build_equals_scalar_build_and_pack() {
-        let f = fixture();
-        let (ctx, soft, states, up, cases) = (f.ctx, f.soft, &f.states, f.up, &f.cases);
-        let (h, w, cold, dv) = built(f.lanes(), up, &ctx, states);
+    /// Builds `cases` into a group (an empty lane after them) and asserts that packing each
+    /// lane from the scalar build over it changes nothing; returns the group.
+    fn built_as_packed(
+        f: &Fixture,
+        cases: &[(u32, ContactInput, ConstraintBodies)],
+    ) -> (WideHead, WideContact, WideCold, WideDerived) {
+        let (ctx, soft, states, up) = (f.ctx, f.soft, &f.states, f.up);
+        let lanes: [LaneInput<'_>; LANES] = core::array::from_fn(|l| cases.get(l).map(|(c, i, b)| (*c, i, b)));
+        let (h, w, cold, dv) = built(lanes, up, &ctx, states);
         // Packed lane by lane over a copy whose ready-made part is spoilt first: pack must
         // make it again.
         let (mut rh, mut r, mut rcold) = (h, w, cold);
@@ -1632,6 +1637,14 @@ mod tests {
         assert_eq!(format!("{w:?}"), format!("{r:?}"));
         assert_eq!(format!("{cold:?}"), format!("{rcold:?}"));
         assert_eq!(format!("{dv:?}"), format!("{rdv:?}"));
+        (h, w, cold, dv)
+    }
+
+    #[test]
+    fn wide_build_equals_scalar_build_and_pack() {
+        let f = fixture();
+        let (ctx, soft, states, up, cases) = (f.ctx, f.soft, &f.states, f.up, &f.cases);
+        let (h, w, cold, dv) = built_as_packed(&f, cases);
         // The ready-made part, lane by lane from the scalar build: the moments of the
         // friction row's anchors, at the middle of two points (at the point of one), K⁻¹
         // from the block's K and 1/det K (zeros, the middle one −0, where the block does
@@ -1769,6 +1782,33 @@ mod tests {
     /// comes out as built into zeroed ones, with and without warm starting (whose fields
     /// it writes either way). Checked by mutation: without the zero written into `approach`
     /// or the rolling impulse left unwritten without warm starting, it fails.
+
+    /// The build against the scalar build and pack where no point is new (a resting pile's
+    /// path: each point's own stick flag, no velocities read), with flags the build must
+    /// ignore on the absent second point of a one-point manifold, and a lane whose side A
+    /// is the static slot 0 but has mass (written back only for a non-zero index). (A
+    /// lane without points is not a case: only touching contacts are built, and they have
+    /// a point; its friction sum would start from +0.0 here, from −0.0 in `pack`.)
+    #[test]
+    fn wide_build_equals_scalar_build_without_new_points() {
+        let f = fixture();
+        let mut one = input(1, false, 0.0, 0.0);
+        one.points[1].flags = INPUT_STICK | INPUT_FRESH;
+        let mut static_with_mass = bodies(0, 3);
+        (static_with_mass.inv_mass_a, static_with_mass.inv_i_a) = (0.5, 3.0);
+        let cases = [
+            (7u32, input(2, false, 0.0, 0.0), bodies(1, 2)),
+            (9, one, static_with_mass),
+            (12, input(2, false, 0.4, 0.05), bodies(2, 1)),
+        ];
+        let (h, _, cold, _) = built_as_packed(&f, &cases);
+        // What the cases claim: no point is new; the first point of each lane sticks (it
+        // lies at x > 0), the second of a two-point lane slides, the one-point lane's
+        // absent point neither; lane 1's side A is not written back, its side B is.
+        assert_eq!(cold.fresh, [[false; LANES]; 2]);
+        assert_eq!(cold.stick, [[true, true, true, false], [false; LANES]]);
+        assert!(!h.write_a[1] && h.write_b[1] && h.write_a[0] && h.write_b[2]);
+    }
     #[test]
     fn build_writes_every_field() {
         let f = fixture();

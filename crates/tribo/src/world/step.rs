@@ -414,9 +414,11 @@ impl World {
         // recycled (a resting pile: large_pyramid 0 %) those lines would be loaded for
         // nothing (its collide +13 %).
         let geometry_ahead = self.collided_many;
-        // The bodies and shapes ahead are asked for only when their arrays would crowd a
-        // core's cache ([`NEAR_PREFETCH_BYTES`]); below that they stay there, and the
-        // prefetches are just instructions, two dozen a contact.
+        // None of the contact ahead's data (bodies, shape bounds, geometry) is asked for
+        // unless the bodies' and bounds' arrays would crowd a core's cache
+        // ([`NEAR_PREFETCH_BYTES`]); below that the scene's data stays there, and the
+        // prefetches are just instructions, two dozen a contact (the tumbler, 0.26 MiB, with
+        // the geometry's prefetch kept alone: collide +3.1 %, 5 alternated pairs).
         let footprint = core::mem::size_of_val(solver_bodies) + core::mem::size_of_val(bounds);
         let near_ahead = footprint > NEAR_PREFETCH_BYTES;
         let collided_total = core::sync::atomic::AtomicU32::new(0);
@@ -1325,11 +1327,13 @@ const CONTACT_CHUNK: usize = 256;
 const NARROW_PREFETCH: usize = 4;
 
 /// The size [bytes] of the solver bodies and shape bounds above which the narrow phase
-/// asks for those of the contacts a few ahead: three quarters of a core's L2 cache on the
-/// AMD EPYC the benchmark runs on (1 MiB; the contact records stream through it too).
-/// Collide stage without those prefetches, 2–3 alternated rounds each (footprint): tumbler
-/// −2.4 % (0.26 MiB), compounds −0.8 % (0.57), large_pyramid −4.5 % (0.62); spinner +6 %
-/// (0.76), junkyard +12 % (0.99), smash +8 % (1.17), many_pyramids +2.6 % (2.7).
+/// asks for the bodies, bounds and (in a pile in motion) shape geometry of the contacts a
+/// few ahead: three quarters of a core's L2 cache on the AMD EPYC the benchmark runs on
+/// (1 MiB; the contact records stream through it too). Tuned on that one machine: a core
+/// with a smaller L2 would want it lower. Collide stage without those prefetches, 2–3
+/// alternated rounds each (footprint): tumbler −2.4 % (0.26 MiB), compounds −0.8 % (0.57),
+/// large_pyramid −4.5 % (0.62); spinner +6 % (0.76, a few per cent above the line),
+/// junkyard +12 % (0.99), smash +8 % (1.17), many_pyramids +2.6 % (2.7).
 const NEAR_PREFETCH_BYTES: usize = 768 << 10;
 
 /// How many contacts ahead the narrow phase asks for the contact record itself (many_pyramids'
