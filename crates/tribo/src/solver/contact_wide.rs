@@ -1777,12 +1777,6 @@ mod tests {
         (head, w)
     }
 
-    /// The build writes every field of the group's `WideHead` and `WideContact` (it does
-    /// not clear them first): built over either poisoned group ([`poisoned`]), the group
-    /// comes out as built into zeroed ones, with and without warm starting (whose fields
-    /// it writes either way). Checked by mutation: without the zero written into `approach`
-    /// or the rolling impulse left unwritten without warm starting, it fails.
-
     /// The build against the scalar build and pack where no point is new (a resting pile's
     /// path: each point's own stick flag, no velocities read), with flags the build must
     /// ignore on the absent second point of a one-point manifold, and a lane whose side A
@@ -1809,6 +1803,12 @@ mod tests {
         assert_eq!(cold.stick, [[true, true, true, false], [false; LANES]]);
         assert!(!h.write_a[1] && h.write_b[1] && h.write_a[0] && h.write_b[2]);
     }
+
+    /// The build writes every field of the group's `WideHead` and `WideContact` (it does
+    /// not clear them first): built over either poisoned group ([`poisoned`]), the group
+    /// comes out as built into zeroed ones, with and without warm starting (whose fields
+    /// it writes either way). Checked by mutation: without the zero written into `approach`
+    /// or the rolling impulse left unwritten without warm starting, it fails.
     #[test]
     fn build_writes_every_field() {
         let f = fixture();
