@@ -588,17 +588,7 @@ impl M4 {
     /// The lanes where `a` or `b` is zero.
     #[inline(always)]
     pub fn either_zero(a: [u32; LANES], b: [u32; LANES]) -> M4 {
-        simd!(
-            {
-                let v = |x: [u32; LANES]| _mm_setr_epi32(x[0] as i32, x[1] as i32, x[2] as i32, x[3] as i32);
-                let z = _mm_setzero_si128();
-                sse::to_m(_mm_castsi128_ps(_mm_or_si128(
-                    _mm_cmpeq_epi32(v(a), z),
-                    _mm_cmpeq_epi32(v(b), z),
-                )))
-            },
-            M4::new(lanes!(|i| mask(a[i] == 0 || b[i] == 0)))
-        )
+        M4::zero_lanes(a) | M4::zero_lanes(b)
     }
 
     /// The four lanes of a mask (each lane all ones or all zeros) as booleans.

@@ -1561,14 +1561,13 @@ mod tests {
 
     impl Fixture {
         fn lanes(&self) -> [LaneInput<'_>; LANES] {
-            let c = &self.cases;
-            [
-                Some((c[0].0, &c[0].1, &c[0].2)),
-                Some((c[1].0, &c[1].1, &c[1].2)),
-                Some((c[2].0, &c[2].1, &c[2].2)),
-                None,
-            ]
+            lanes_of(&self.cases)
         }
+    }
+
+    /// The lanes of `cases` in order, empty after them.
+    fn lanes_of(cases: &[(u32, ContactInput, ConstraintBodies)]) -> [LaneInput<'_>; LANES] {
+        core::array::from_fn(|l| cases.get(l).map(|(c, i, b)| (*c, i, b)))
     }
 
     fn fixture() -> Fixture {
@@ -1609,8 +1608,7 @@ mod tests {
         cases: &[(u32, ContactInput, ConstraintBodies)],
     ) -> (WideHead, WideContact, WideCold, WideDerived) {
         let (ctx, soft, states, up) = (f.ctx, f.soft, &f.states, f.up);
-        let lanes: [LaneInput<'_>; LANES] = core::array::from_fn(|l| cases.get(l).map(|(c, i, b)| (*c, i, b)));
-        let (h, w, cold, dv) = built(lanes, up, &ctx, states);
+        let (h, w, cold, dv) = built(lanes_of(cases), up, &ctx, states);
         // Packed lane by lane over a copy whose ready-made part is spoilt first: pack must
         // make it again.
         let (mut rh, mut r, mut rcold) = (h, w, cold);
