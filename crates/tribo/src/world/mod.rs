@@ -217,7 +217,6 @@ pub struct World {
     pub(crate) unsolved_contacts: Vec<u32>,
     pub(crate) scratch_u32: Vec<u32>,
     pub(crate) scratch_f32: Vec<f32>,
-    pub(crate) scratch_mark: Vec<bool>,
     /// At least 1 in 8 of the contacts the last narrow phase visited were collided in
     /// full (not recycled): the next one asks for the shapes' geometry ahead too.
     pub(crate) collided_many: bool,
@@ -323,7 +322,6 @@ impl World {
             unsolved_contacts: Vec::new(),
             scratch_u32: Vec::new(),
             scratch_f32: Vec::new(),
-            scratch_mark: Vec::new(),
             collided_many: false,
             scratch_flags: Vec::new(),
             mostly_awake: false,
