@@ -621,10 +621,17 @@ impl World {
             }
             return;
         }
-        for (bi, b) in self.bodies.iter() {
-            if !b.awake || b.body_type == BodyType::Static {
-                continue;
-            }
+        // The awake moving bodies are those with a solver state (`solved`, which set
+        // `flags` too, in the body pass just made): found through the step data, not a
+        // scan of every body slot (9 600 in smash while its block sleeps: 190 000
+        // instructions a step).
+        for sim in self.sims.iter().skip(1) {
+            let bi = sim.body;
+            let Some(b) = self.bodies.at(bi) else { continue };
+            debug_assert!(
+                solved(b) && active(bi),
+                "body {bi} has a solver state but is not solved"
+            );
             for &ci in &b.contacts {
                 let Some(Some(c)) = self.contacts.get(ci as usize) else {
                     continue;
