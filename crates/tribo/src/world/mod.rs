@@ -210,7 +210,8 @@ pub struct World {
     /// found by `World::prepare_bodies` while it makes them).
     pub(crate) any_load: bool,
     /// Contacts the narrow phase of the current step listed: those with an awake moving
-    /// body; none when most bodies are awake (each contact then tests its bodies).
+    /// body, sorted, each once (each chunk of the narrow phase visits its share); none
+    /// when most bodies are awake (each contact then tests its bodies).
     pub(crate) active_contacts: Vec<u32>,
     /// The touching contacts the narrow phase visited that the solver does not take (no
     /// awake dynamic side), in contact order: with `solver_contacts`, every touching one.
