@@ -598,8 +598,10 @@ impl ContactSolver {
         let mut single_counts = [0u32; COLORS];
         let mut any_restitution = false;
         let mut overflow = false;
-        for (i, (contact, key)) in candidates.keys().enumerate() {
-            contact_of.push(contact);
+        // Every listed contact has its key (the keys are kept for every contact slot), so
+        // the contacts are the list itself: copied whole, not pushed one by one.
+        contact_of.extend_from_slice(candidates.list);
+        for (i, (_, key)) in candidates.keys().enumerate() {
             if key.flags & KEY_RATIO != 0 {
                 light.extend(candidates.get(i).and_then(|cand| self.light_body(cand, sims)));
             }
