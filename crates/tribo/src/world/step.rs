@@ -401,7 +401,7 @@ impl World {
             // order), and each chunk visits its share of the list, not its slots: a sleeping
             // contact costs nothing. (Visiting every slot and testing a mark cost 28
             // instructions a slot: smash's 37 800 contacts while the block sleeps, 1.06 M
-            // instructions a step, 80 µs against Box2D's 3.)
+            // instructions and 53 µs a step, against Box2D's 3 µs.)
             self.collect_active_contacts(&mut active, &flags, false, false);
         }
         let (flags_ref, active_ref, lists_ref) = (flags.as_slice(), active.as_slice(), lists.as_slice());
@@ -1338,7 +1338,8 @@ impl ChunkOutcomes {
         self.special.clear();
     }
 
-    /// Files contact `ci`'s verdict.
+    /// Files contact `ci`'s verdict (inlined into both of the narrow phase's filing loops,
+    /// the mostly-awake one and the listed contacts' one).
     #[inline(always)]
     fn note(&mut self, ci: u32, outcome: NarrowOutcome, solvable: bool) {
         match outcome {
