@@ -428,6 +428,9 @@ impl World {
                 let mut collided = 0u32;
                 let len = slots.len();
                 // The active contacts of this chunk (all its slots when mostly awake).
+                // A listed contact's slot in this chunk (the list's share below holds only
+                // contacts from `first` on).
+                let local = |ci: u32| (ci as usize).wrapping_sub(first);
                 let mine = if mostly_awake {
                     &[][..]
                 } else {
@@ -490,13 +493,9 @@ impl World {
                         visit!(k, Some(k + RECORD_PREFETCH), Some(k + NARROW_PREFETCH));
                     }
                 } else {
-                    let slot_of = |j: usize| mine.get(j).map(|&ci| (ci as usize).wrapping_sub(first));
+                    let slot_of = |j: usize| mine.get(j).map(|&ci| local(ci));
                     for (j, &ci) in mine.iter().enumerate() {
-                        visit!(
-                            (ci as usize).wrapping_sub(first),
-                            slot_of(j + RECORD_PREFETCH),
-                            slot_of(j + NARROW_PREFETCH)
-                        );
+                        visit!(local(ci), slot_of(j + RECORD_PREFETCH), slot_of(j + NARROW_PREFETCH));
                     }
                 }
                 // The chunk's verdicts filed in its lists, from the dense outcomes just
@@ -509,7 +508,7 @@ impl World {
                         }
                     } else {
                         for &ci in mine {
-                            if let Some(&(outcome, solvable)) = outs.get((ci as usize).wrapping_sub(first)) {
+                            if let Some(&(outcome, solvable)) = outs.get(local(ci)) {
                                 list.note(ci, outcome, solvable);
                             }
                         }
