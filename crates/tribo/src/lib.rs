@@ -64,3 +64,10 @@ pub use world::{
     BodyId, ContactBeginEvent, ContactEndEvent, ContactEvents, ContactInfo, ContactPointInfo, JointId, Profile,
     QueryFilter, RayResult, ShapeId, World, WorldDef,
 };
+
+/// Contact constraints the wide solver handles at once in this build: 4 (SSE2, the x86-64
+/// baseline and any other target) or 8 when the crate is compiled for AVX2 (`RUSTFLAGS="-C
+/// target-feature=+avx2"`, the counterpart of Box2D's `BOX2D_AVX2` option). Results do not
+/// depend on it: every lane computes the same expressions, so both builds step a scene to
+/// the same bits (`.ci/run` compares their trajectories).
+pub const SOLVER_LANES: usize = math::wide::LANES;

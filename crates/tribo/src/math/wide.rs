@@ -15,8 +15,40 @@
 use super::Vec2;
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub, SubAssign};
 
-/// Lanes per wide constraint.
-pub(crate) const LANES: usize = 4;
+/// Lanes of [`F4`].
+pub(crate) const LANES4: usize = 4;
+
+/// The wide contact solver's lane vectors: [`F4`], [`M4`] and [`V4`] (SSE, four lanes),
+/// or in a build for AVX2 (`-C target-feature=+avx2`, as Box2D's `BOX2D_AVX2`) the
+/// eight-lane [`super::wide8::F8`], `M8` and `V8`. A lane computes the same expressions
+/// either way; only how many constraints a group holds changes.
+#[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+pub(crate) use self::{F4 as FL, M4 as ML, V4 as VL};
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+pub(crate) use super::wide8::{F8 as FL, M8 as ML, V8 as VL};
+
+/// Lanes per wide constraint (of [`FL`]).
+pub(crate) const LANES: usize = core::mem::size_of::<FL>() / 4;
+
+/// `LANES` 16-byte rows (one per lane: a body's state row, a contact's input row) as four
+/// lane vectors: lane `l` of output `i` is element `i` of row `l` (the 4×4 [`transpose`]
+/// with four lanes).
+#[inline(always)]
+pub(crate) fn rows_to_lanes(rows: [F4; LANES]) -> [FL; 4] {
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+    return transpose(rows);
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    return super::wide8::rows_to_lanes8(rows);
+}
+
+/// The inverse of [`rows_to_lanes`]: four lane vectors as `LANES` 16-byte rows.
+#[inline(always)]
+pub(crate) fn lanes_to_rows(cols: [FL; 4]) -> [F4; LANES] {
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+    return transpose(cols);
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    return super::wide8::lanes_to_rows8(cols);
+}
 
 /// The register a lane vector lives in: an SSE register on x86-64 (so LLVM keeps it whole
 /// where branches meet, instead of taking a four-`f32` array apart into scalars there and
@@ -25,9 +57,9 @@ pub(crate) const LANES: usize = 4;
 #[cfg(target_arch = "x86_64")]
 type Raw = core::arch::x86_64::__m128;
 #[cfg(not(target_arch = "x86_64"))]
-type RawF = [f32; LANES];
+type RawF = [f32; LANES4];
 #[cfg(not(target_arch = "x86_64"))]
-type RawM = [u32; LANES];
+type RawM = [u32; LANES4];
 #[cfg(target_arch = "x86_64")]
 type RawF = Raw;
 #[cfg(target_arch = "x86_64")]
@@ -51,16 +83,16 @@ const _: () = assert!(core::mem::size_of::<F4>() == 16 && core::mem::size_of::<M
 macro_rules! lane_array {
     ($t:ident, $e:ty, $view:ident, $view_mut:ident) => {
         impl core::ops::Deref for $t {
-            type Target = [$e; LANES];
+            type Target = [$e; LANES4];
             #[inline(always)]
-            fn deref(&self) -> &[$e; LANES] {
+            fn deref(&self) -> &[$e; LANES4] {
                 as_lanes::$view(&self.0)
             }
         }
 
         impl core::ops::DerefMut for $t {
             #[inline(always)]
-            fn deref_mut(&mut self) -> &mut [$e; LANES] {
+            fn deref_mut(&mut self) -> &mut [$e; LANES4] {
                 as_lanes::$view_mut(&mut self.0)
             }
         }
@@ -91,7 +123,7 @@ impl Default for F4 {
 
 impl Default for M4 {
     fn default() -> M4 {
-        M4::new([0; LANES])
+        M4::new([0; LANES4])
     }
 }
 
@@ -99,69 +131,69 @@ impl Default for M4 {
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 mod as_lanes {
-    use super::{Raw, LANES};
+    use super::{Raw, LANES4};
 
     #[inline(always)]
-    pub fn f(r: &Raw) -> &[f32; LANES] {
+    pub fn f(r: &Raw) -> &[f32; LANES4] {
         // SAFETY: `__m128` is 16 bytes of four `f32` lanes in order (lane 0 first), aligned
         // to 16; every bit pattern is a valid `f32` and `u32`, and the borrow is the
         // register's.
-        unsafe { &*(r as *const Raw as *const [f32; LANES]) }
+        unsafe { &*(r as *const Raw as *const [f32; LANES4]) }
     }
 
     #[inline(always)]
-    pub fn f_mut(r: &mut Raw) -> &mut [f32; LANES] {
+    pub fn f_mut(r: &mut Raw) -> &mut [f32; LANES4] {
         // SAFETY: as `f`.
-        unsafe { &mut *(r as *mut Raw as *mut [f32; LANES]) }
+        unsafe { &mut *(r as *mut Raw as *mut [f32; LANES4]) }
     }
 
     #[inline(always)]
-    pub fn m(r: &Raw) -> &[u32; LANES] {
+    pub fn m(r: &Raw) -> &[u32; LANES4] {
         // SAFETY: as `f`.
-        unsafe { &*(r as *const Raw as *const [u32; LANES]) }
+        unsafe { &*(r as *const Raw as *const [u32; LANES4]) }
     }
 
     #[inline(always)]
-    pub fn m_mut(r: &mut Raw) -> &mut [u32; LANES] {
+    pub fn m_mut(r: &mut Raw) -> &mut [u32; LANES4] {
         // SAFETY: as `f`.
-        unsafe { &mut *(r as *mut Raw as *mut [u32; LANES]) }
+        unsafe { &mut *(r as *mut Raw as *mut [u32; LANES4]) }
     }
 
     /// An array's lanes as a register (a constant expression).
-    pub const fn from_f(a: [f32; LANES]) -> Raw {
+    pub const fn from_f(a: [f32; LANES4]) -> Raw {
         // SAFETY: same size, every bit pattern valid (see `f`).
-        unsafe { core::mem::transmute::<[f32; LANES], Raw>(a) }
+        unsafe { core::mem::transmute::<[f32; LANES4], Raw>(a) }
     }
 
-    pub const fn from_m(a: [u32; LANES]) -> Raw {
+    pub const fn from_m(a: [u32; LANES4]) -> Raw {
         // SAFETY: as `from_f`.
-        unsafe { core::mem::transmute::<[u32; LANES], Raw>(a) }
+        unsafe { core::mem::transmute::<[u32; LANES4], Raw>(a) }
     }
 }
 
 #[cfg(not(target_arch = "x86_64"))]
 mod as_lanes {
-    use super::LANES;
+    use super::LANES4;
     #[inline(always)]
-    pub fn f(r: &[f32; LANES]) -> &[f32; LANES] {
+    pub fn f(r: &[f32; LANES4]) -> &[f32; LANES4] {
         r
     }
     #[inline(always)]
-    pub fn f_mut(r: &mut [f32; LANES]) -> &mut [f32; LANES] {
+    pub fn f_mut(r: &mut [f32; LANES4]) -> &mut [f32; LANES4] {
         r
     }
     #[inline(always)]
-    pub fn m(r: &[u32; LANES]) -> &[u32; LANES] {
+    pub fn m(r: &[u32; LANES4]) -> &[u32; LANES4] {
         r
     }
     #[inline(always)]
-    pub fn m_mut(r: &mut [u32; LANES]) -> &mut [u32; LANES] {
+    pub fn m_mut(r: &mut [u32; LANES4]) -> &mut [u32; LANES4] {
         r
     }
-    pub const fn from_f(a: [f32; LANES]) -> [f32; LANES] {
+    pub const fn from_f(a: [f32; LANES4]) -> [f32; LANES4] {
         a
     }
-    pub const fn from_m(a: [u32; LANES]) -> [u32; LANES] {
+    pub const fn from_m(a: [u32; LANES4]) -> [u32; LANES4] {
         a
     }
 }
@@ -169,7 +201,7 @@ mod as_lanes {
 impl F4 {
     /// Lanes from an array.
     #[inline(always)]
-    pub const fn new(a: [f32; LANES]) -> F4 {
+    pub const fn new(a: [f32; LANES4]) -> F4 {
         F4(as_lanes::from_f(a))
     }
 }
@@ -177,7 +209,7 @@ impl F4 {
 impl M4 {
     /// Masks from an array.
     #[inline(always)]
-    pub const fn new(a: [u32; LANES]) -> M4 {
+    pub const fn new(a: [u32; LANES4]) -> M4 {
         M4(as_lanes::from_m(a))
     }
 }
@@ -257,6 +289,20 @@ mod sse {
     }
 }
 
+/// The SSE register of an `F4` (for the eight-lane type's row transposes).
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+#[inline(always)]
+pub(crate) fn sse_register(x: F4) -> core::arch::x86_64::__m128 {
+    x.0
+}
+
+/// An `F4` from its SSE register.
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+#[inline(always)]
+pub(crate) fn from_sse_register(v: core::arch::x86_64::__m128) -> F4 {
+    F4(v)
+}
+
 /// `$sse` (an expression over `core::arch::x86_64` and [`sse`]) on x86-64, else `$lanes`.
 macro_rules! simd {
     ($sse:expr, $lanes:expr) => {{
@@ -276,9 +322,9 @@ macro_rules! simd {
 #[cfg_attr(target_arch = "x86_64", allow(unused_macros))]
 macro_rules! lanes {
     (|$i:ident| $e:expr) => {{
-        let mut out = [Default::default(); LANES];
+        let mut out = [Default::default(); LANES4];
         let mut $i = 0;
-        while $i < LANES {
+        while $i < LANES4 {
             out[$i] = $e;
             $i += 1;
         }
@@ -287,11 +333,11 @@ macro_rules! lanes {
 }
 
 impl F4 {
-    pub const ZERO: F4 = F4::new([0.0; LANES]);
+    pub const ZERO: F4 = F4::new([0.0; LANES4]);
 
     #[inline(always)]
     pub fn splat(x: f32) -> F4 {
-        simd!(sse::to_f(_mm_set1_ps(x)), F4::new([x; LANES]))
+        simd!(sse::to_f(_mm_set1_ps(x)), F4::new([x; LANES4]))
     }
 
     /// Lane-wise maximum (`a > b ? a : b`, like SSE `maxps` with the operands swapped).
@@ -388,7 +434,7 @@ impl F4 {
 /// 16-byte rows into four lanes of each field and back; `_MM_TRANSPOSE4_PS`, eight
 /// shuffles instead of sixteen single-lane moves).
 #[inline(always)]
-pub(crate) fn transpose(rows: [F4; LANES]) -> [F4; LANES] {
+pub(crate) fn transpose(rows: [F4; LANES4]) -> [F4; LANES4] {
     simd!(
         {
             let [r0, r1, r2, r3] = rows.map(sse::f);
@@ -409,7 +455,7 @@ pub(crate) fn transpose(rows: [F4; LANES]) -> [F4; LANES] {
 /// Four 2D points as lanes of x and of y: `([p0.x, p1.x, p2.x, p3.x], [p0.y, …])` (four
 /// shuffles of the points' coordinates).
 #[inline(always)]
-pub(crate) fn split_xy(p: [Vec2; LANES]) -> (F4, F4) {
+pub(crate) fn split_xy(p: [Vec2; LANES4]) -> (F4, F4) {
     let (a, b) = ([p[0].x, p[0].y, p[1].x, p[1].y], [p[2].x, p[2].y, p[3].x, p[3].y]);
     simd!(
         {
@@ -423,8 +469,8 @@ pub(crate) fn split_xy(p: [Vec2; LANES]) -> (F4, F4) {
 
 /// The inverse of [`split_xy`]: four points from lanes of x and of y (four shuffles).
 #[inline(always)]
-pub(crate) fn join_xy(x: F4, y: F4) -> [Vec2; LANES] {
-    let [a, b]: [[f32; LANES]; 2] = simd!(
+pub(crate) fn join_xy(x: F4, y: F4) -> [Vec2; LANES4] {
+    let [a, b]: [[f32; LANES4]; 2] = simd!(
         {
             let (x, y) = (sse::f(x), sse::f(y));
             [*sse::to_f(_mm_unpacklo_ps(x, y)), *sse::to_f(_mm_unpackhi_ps(x, y))]
@@ -484,9 +530,9 @@ pub(crate) fn bounds_of_points<const GROUPS: usize>(x: [F4; GROUPS], y: [F4; GRO
             ([lo[0], lo[1]], [hi[0], hi[1]])
         },
         {
-            let lane = |v: &[F4; GROUPS], i: usize| v[i / LANES][i % LANES];
+            let lane = |v: &[F4; GROUPS], i: usize| v[i / LANES4][i % LANES4];
             let fold = |v: &[F4; GROUPS], less: fn(f32, f32) -> bool| {
-                (1..LANES * GROUPS).fold(
+                (1..LANES4 * GROUPS).fold(
                     lane(v, 0),
                     |acc, i| {
                         if less(lane(v, i), acc) {
@@ -520,7 +566,7 @@ impl M4 {
 
     /// A mask from four booleans.
     #[inline(always)]
-    pub fn from_bools(b: [bool; LANES]) -> M4 {
+    pub fn from_bools(b: [bool; LANES4]) -> M4 {
         M4::new(b.map(mask))
     }
 
@@ -529,7 +575,7 @@ impl M4 {
     /// instructions, where building the lanes one by one took about fifteen; booleans just
     /// computed are better made into lanes directly, by `from_bools`).
     #[inline(always)]
-    pub fn from_stored_bools(b: [bool; LANES]) -> M4 {
+    pub fn from_stored_bools(b: [bool; LANES4]) -> M4 {
         simd!(
             {
                 // Lane l holds bit 0 of byte l of the word (a bool's byte is 0 or 1).
@@ -547,7 +593,7 @@ impl M4 {
     /// The lanes whose byte in `b` is not zero (as [`M4::from_stored_bools`]: the same
     /// word, each lane's byte compared with zero and the result negated).
     #[inline(always)]
-    pub fn from_nonzero_bytes(b: [u8; LANES]) -> M4 {
+    pub fn from_nonzero_bytes(b: [u8; LANES4]) -> M4 {
         simd!(
             {
                 let word = i32::from_le_bytes(b);
@@ -561,7 +607,7 @@ impl M4 {
 
     /// The lanes where `a` is zero.
     #[inline(always)]
-    pub fn zero_lanes(a: [u32; LANES]) -> M4 {
+    pub fn zero_lanes(a: [u32; LANES4]) -> M4 {
         simd!(
             sse::to_m(_mm_castsi128_ps(_mm_cmpeq_epi32(
                 _mm_setr_epi32(a[0] as i32, a[1] as i32, a[2] as i32, a[3] as i32),
@@ -574,7 +620,7 @@ impl M4 {
     /// The lanes where `a` is greater than `k` (unsigned: both offset by 2³¹ for the
     /// signed compare).
     #[inline(always)]
-    pub fn above(a: [u32; LANES], k: u32) -> M4 {
+    pub fn above(a: [u32; LANES4], k: u32) -> M4 {
         simd!(
             {
                 let flip = |x: u32| (x ^ 0x8000_0000) as i32;
@@ -587,13 +633,13 @@ impl M4 {
 
     /// The lanes where `a` or `b` is zero.
     #[inline(always)]
-    pub fn either_zero(a: [u32; LANES], b: [u32; LANES]) -> M4 {
+    pub fn either_zero(a: [u32; LANES4], b: [u32; LANES4]) -> M4 {
         M4::zero_lanes(a) | M4::zero_lanes(b)
     }
 
     /// The four lanes of a mask (each lane all ones or all zeros) as booleans.
     #[inline(always)]
-    pub fn to_bools(self) -> [bool; LANES] {
+    pub fn to_bools(self) -> [bool; LANES4] {
         simd!(
             {
                 let bits = _mm_movemask_ps(sse::m(self));
@@ -727,61 +773,75 @@ impl Not for M4 {
     }
 }
 
-/// Four 2D vectors, one per lane.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct V4 {
-    pub x: F4,
-    pub y: F4,
-}
-
-impl V4 {
-    #[inline(always)]
-    pub fn dot(self, o: V4) -> F4 {
-        self.x * o.x + self.y * o.y
-    }
-
-    /// z of the 3D cross product, lane by lane.
-    #[inline(always)]
-    pub fn cross(self, o: V4) -> F4 {
-        self.x * o.y - self.y * o.x
-    }
-
-    /// (y, −x): the vector turned clockwise (`Vec2::right_perp`; the tangent of a normal).
-    #[inline(always)]
-    pub fn right_perp(self) -> V4 {
-        V4 { x: self.y, y: -self.x }
-    }
-
-    #[inline(always)]
-    pub fn scale(self, s: F4) -> V4 {
-        V4 {
-            x: s * self.x,
-            y: s * self.y,
+/// A 2D vector of lanes `$v` over the lane type `$f` (x and y as lanes), with the few
+/// operations the wide solver uses.
+macro_rules! lane_vectors {
+    ($v:ident, $f:ident, $doc:literal) => {
+        #[doc = $doc]
+        #[derive(Clone, Copy, Debug, Default, PartialEq)]
+        pub(crate) struct $v {
+            pub x: $f,
+            pub y: $f,
         }
-    }
-}
 
-impl Add for V4 {
-    type Output = V4;
-    #[inline(always)]
-    fn add(self, o: V4) -> V4 {
-        V4 {
-            x: self.x + o.x,
-            y: self.y + o.y,
-        }
-    }
-}
+        impl $v {
+            #[inline(always)]
+            pub fn dot(self, o: $v) -> $f {
+                self.x * o.x + self.y * o.y
+            }
 
-impl Sub for V4 {
-    type Output = V4;
-    #[inline(always)]
-    fn sub(self, o: V4) -> V4 {
-        V4 {
-            x: self.x - o.x,
-            y: self.y - o.y,
+            /// z of the 3D cross product, lane by lane.
+            #[inline(always)]
+            pub fn cross(self, o: $v) -> $f {
+                self.x * o.y - self.y * o.x
+            }
+
+            /// (y, −x): the vector turned clockwise (`Vec2::right_perp`; the tangent of a
+            /// normal).
+            #[inline(always)]
+            pub fn right_perp(self) -> $v {
+                $v {
+                    x: self.y,
+                    y: -self.x,
+                }
+            }
+
+            #[inline(always)]
+            pub fn scale(self, s: $f) -> $v {
+                $v {
+                    x: s * self.x,
+                    y: s * self.y,
+                }
+            }
         }
-    }
+
+        impl core::ops::Add for $v {
+            type Output = $v;
+            #[inline(always)]
+            fn add(self, o: $v) -> $v {
+                $v {
+                    x: self.x + o.x,
+                    y: self.y + o.y,
+                }
+            }
+        }
+
+        impl core::ops::Sub for $v {
+            type Output = $v;
+            #[inline(always)]
+            fn sub(self, o: $v) -> $v {
+                $v {
+                    x: self.x - o.x,
+                    y: self.y - o.y,
+                }
+            }
+        }
+    };
 }
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+pub(crate) use lane_vectors;
+
+lane_vectors!(V4, F4, "Four 2D vectors, one per lane.");
 
 #[cfg(test)]
 mod tests {
@@ -793,24 +853,24 @@ mod tests {
     /// lane).
     #[test]
     fn masks_from_bytes_set_exactly_their_lanes() {
-        let lanes = |m: M4| core::array::from_fn::<bool, LANES, _>(|l| m.lane(l));
+        let lanes = |m: M4| core::array::from_fn::<bool, LANES4, _>(|l| m.lane(l));
         for pattern in 0..16u32 {
-            let b: [bool; LANES] = core::array::from_fn(|l| pattern >> l & 1 == 1);
+            let b: [bool; LANES4] = core::array::from_fn(|l| pattern >> l & 1 == 1);
             let all = b.map(|x| if x { u32::MAX } else { 0 });
             assert_eq!(lanes(M4::from_stored_bools(b)), b, "{b:?}");
             assert_eq!((*M4::from_stored_bools(b), *M4::from_bools(b)), (all, all));
         }
         for x in 0..=255u8 {
-            for l in 0..LANES {
-                let mut bytes = [0u8; LANES];
+            for l in 0..LANES4 {
+                let mut bytes = [0u8; LANES4];
                 bytes[l] = x;
-                let expected: [bool; LANES] = core::array::from_fn(|k| k == l && x != 0);
+                let expected: [bool; LANES4] = core::array::from_fn(|k| k == l && x != 0);
                 assert_eq!(lanes(M4::from_nonzero_bytes(bytes)), expected, "{bytes:?}");
                 // The other lanes full: only lane l depends on x.
                 let others = bytes.map(|b| if b == 0 { 7 } else { b });
                 let mut full = others;
                 full[l] = x;
-                let expected: [bool; LANES] = core::array::from_fn(|k| k != l || x != 0);
+                let expected: [bool; LANES4] = core::array::from_fn(|k| k != l || x != 0);
                 assert_eq!(lanes(M4::from_nonzero_bytes(full)), expected, "{full:?}");
             }
         }
@@ -855,7 +915,7 @@ mod tests {
         // Body indices: 0 is the static body; u32::MAX must not read as a negative zero.
         let (ia, ib) = ([0, 7, 3, u32::MAX], [5, 0, 9, 1]);
         assert_eq!(*M4::either_zero(ia, ib), [u32::MAX, u32::MAX, 0, 0]);
-        assert_eq!(*M4::either_zero([0; LANES], [0; LANES]), [u32::MAX; LANES]);
+        assert_eq!(*M4::either_zero([0; LANES4], [0; LANES4]), [u32::MAX; LANES4]);
         assert_eq!(*M4::zero_lanes([0, u32::MAX, 1, 0]), [u32::MAX, 0, 0, u32::MAX]);
         // `above` compares unsigned words (the signed compare's 2³¹ offset): the largest
         // word is above everything, and words either side of 2³¹ keep their order.

@@ -11,7 +11,7 @@
 //!   colour, so each pass solves them last (the ground has the last word, as in Box2D).
 //!   A constraint that finds no colour goes to the overflow list, solved by the scalar code
 //!   before the coloured work of each pass.
-//! * **Wide layout**: four constraints as structure-of-arrays ([`F4`] lanes), in four
+//! * **Wide layout**: four constraints as structure-of-arrays ([`FL`] lanes), in four
 //!   arrays by use: [`WideHead`] (bodies, normal, masses, anchors, impulses: all the warm
 //!   start reads, so it streams ~400 bytes per group, not 1 KiB), [`WideContact`] (the
 //!   rest the solve passes read), [`WideDerived`] (what the solve passes would derive again
@@ -35,7 +35,7 @@ use super::contact_solver::{
     fresh_point_sticks, kinetic_energy_of, ConstraintBodies, ConstraintPoint, ContactConstraint, ContactInput,
     StepSoftness, INPUT_FRESH, INPUT_STICK,
 };
-use super::wide::{transpose, F4, LANES, M4, V4};
+use super::wide::{lanes_to_rows, rows_to_lanes, F4, FL, LANES, ML, VL};
 use super::{StateCell, StateRead, StepContext};
 use crate::collision::contact::{Contact, FrictionState, PointState};
 use crate::math::Vec2;
@@ -50,25 +50,25 @@ pub(crate) const DYNAMIC_COLORS: usize = 20;
 /// is in [`HeadPoint`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WidePoint {
-    pub base_separation: F4,
-    pub normal_mass: F4,
-    pub preload: F4,
-    pub total_normal_impulse: F4,
-    pub max_normal_impulse: F4,
+    pub base_separation: FL,
+    pub normal_mass: FL,
+    pub preload: FL,
+    pub total_normal_impulse: FL,
+    pub max_normal_impulse: FL,
     /// `ConstraintPoint::approach`, tracked only in groups with restitution (0 elsewhere:
     /// a point without restitution never bounces, whatever its approach).
-    pub approach: F4,
+    pub approach: FL,
 }
 
 /// One point of four constraints: what the warm start reads and writes.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct HeadPoint {
-    pub r_a: V4,
-    pub r_b: V4,
-    pub normal_impulse: F4,
+    pub r_a: VL,
+    pub r_b: VL,
+    pub normal_impulse: FL,
     /// `ConstraintPoint::substep_vn`, recorded only in groups with restitution
     /// ([`WideHead::any_restitution`]).
-    pub substep_vn: F4,
+    pub substep_vn: FL,
 }
 
 /// The part of four constraints the warm start needs (bodies, normal, masses, anchors,
@@ -89,21 +89,21 @@ pub(crate) struct WideHead {
     /// Some lane has restitution: only then do the passes record the points' approach
     /// speeds (what restitution reads).
     pub any_restitution: bool,
-    pub normal: V4,
-    pub inv_mass_a: F4,
-    pub inv_i_a: F4,
-    pub inv_mass_b: F4,
-    pub inv_i_b: F4,
-    pub split: F4,
+    pub normal: VL,
+    pub inv_mass_a: FL,
+    pub inv_i_a: FL,
+    pub inv_mass_b: FL,
+    pub inv_i_b: FL,
+    pub split: FL,
     /// `ContactConstraint::shift_cap2` of each lane (`contact_solver::capped_shift`).
-    pub shift_cap2: F4,
+    pub shift_cap2: FL,
     pub points: [HeadPoint; 2],
     /// Friction impulse of the row (sum over the points) [N·s].
-    pub tangent_impulse: F4,
+    pub tangent_impulse: FL,
     /// Lanes with a two-point manifold: the friction row sits at the patch middle and each
     /// point reports half its impulse (one point: the whole).
-    pub two_points: M4,
-    pub rolling_impulse: F4,
+    pub two_points: ML,
+    pub rolling_impulse: FL,
 }
 
 /// The rest of four contact constraints, one per lane (see the module docs): what only
@@ -119,21 +119,21 @@ pub(crate) struct WideHead {
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WideContact {
     /// Friction coefficient of the row this step: μs where it sticks, μd where it slides.
-    pub mu: F4,
-    pub tangent_speed: F4,
-    pub rolling_resistance: F4,
+    pub mu: FL,
+    pub tangent_speed: FL,
+    pub rolling_resistance: FL,
     pub points: [WidePoint; 2],
     /// Normal-row matrix K and 1/det K (2-point manifolds with `block`, else 0).
-    pub k11: F4,
-    pub k12: F4,
-    pub k22: F4,
-    pub inv_det: F4,
-    pub block: M4,
-    pub tangent_mass: F4,
-    pub base_drift: F4,
-    pub stick: M4,
-    pub total_tangent_impulse: F4,
-    pub saturated: M4,
+    pub k11: FL,
+    pub k12: FL,
+    pub k22: FL,
+    pub inv_det: FL,
+    pub block: ML,
+    pub tangent_mass: FL,
+    pub base_drift: FL,
+    pub stick: ML,
+    pub total_tangent_impulse: FL,
+    pub saturated: ML,
 }
 
 /// The parts of four constraints the substeps do not touch (kept apart so the hot
@@ -169,15 +169,15 @@ pub(crate) struct WideDerived {
     /// The friction row's anchors' moments about the tangent t = (n.y, −n.x),
     /// (fr_a × t, fr_b × t) [m] (what the passes' [`RowFrame`] needs of them: 32 bytes
     /// instead of the anchors' 64, and two cross products a pass fewer).
-    pub fr_moments: (F4, F4),
+    pub fr_moments: (FL, FL),
     /// Each point's anchors' moments about the normal, (r_a × n, r_b × n) [m]: what
     /// [`RowFrame::point`] derived from the anchors in each pass, now read through
     /// [`RowFrame::point_of`] (the arms' four coordinates are not loaded, and two cross
     /// products a point and pass fewer; ±0 for an absent point).
-    pub normal_moments: [(F4, F4); 2],
-    pub i11: F4,
-    pub i12: F4,
-    pub i22: F4,
+    pub normal_moments: [(FL, FL); 2],
+    pub i11: FL,
+    pub i12: FL,
+    pub i22: FL,
 }
 
 impl WideDerived {
@@ -185,7 +185,7 @@ impl WideDerived {
     /// anchors and normal (in `h`) and its K and 1/det K: the expressions the passes
     /// evaluated each time, so the same bits.
     #[inline(always)]
-    fn new(friction: (V4, V4), t: V4, h: &WideHead, w: &WideContact) -> WideDerived {
+    fn new(friction: (VL, VL), t: VL, h: &WideHead, w: &WideContact) -> WideDerived {
         WideDerived {
             fr_moments: moments(friction, t),
             normal_moments: h.points.map(|p| moments((p.r_a, p.r_b), h.normal)),
@@ -197,33 +197,40 @@ impl WideDerived {
 }
 
 // What the hot passes stream per group of four constraints (bytes).
-const _: () = assert!(core::mem::size_of::<WideDerived>() == 144);
-const _: () = assert!(core::mem::size_of::<WideContact>() == 400);
-const _: () = assert!(core::mem::size_of::<WideHead>() == 416);
+// (In vectors of lanes: 144, 400 and 416 bytes with four lanes, twice that with eight.)
+const VECTOR: usize = core::mem::size_of::<FL>();
+const _: () = assert!(core::mem::size_of::<WideDerived>() == 9 * VECTOR);
+const _: () = assert!(core::mem::size_of::<WideContact>() == 25 * VECTOR);
+const _: () = assert!(core::mem::size_of::<WideHead>() == 26 * VECTOR);
 
 /// Four bodies' velocities and step motion, gathered from [`BodyState`]s.
 #[derive(Clone, Copy, Debug)]
 struct WideBody {
-    v: V4,
-    w: F4,
-    touched: F4,
-    dp: V4,
+    v: VL,
+    w: FL,
+    touched: FL,
+    dp: VL,
     /// sin of the rotation since the step start.
-    dq_s: F4,
+    dq_s: FL,
 }
 
 /// Gathers four bodies: each state's two 16-byte halves (v, w, touched; dp, dq) as rows,
 /// transposed into lanes.
 #[inline(always)]
 fn gather<S: StateRead>(states: &[S], idx: &[u32; LANES]) -> WideBody {
-    let s = idx.map(|i| states[i as usize].rows());
-    let [vx, vy, w, touched] = transpose(s.map(|r| r[0]));
-    let [dpx, dpy, _, dq_s] = transpose(s.map(|r| r[1]));
+    // Lane by lane in a loop the compiler unrolls: `idx.map(…)` over eight lanes was
+    // compiled as a call, its rows passed back through the stack.
+    let mut s = [[F4::ZERO; 2]; LANES];
+    for (row, &i) in s.iter_mut().zip(idx) {
+        *row = states[i as usize].rows();
+    }
+    let [vx, vy, w, touched] = rows_to_lanes(s.map(|r| r[0]));
+    let [dpx, dpy, _, dq_s] = rows_to_lanes(s.map(|r| r[1]));
     WideBody {
-        v: V4 { x: vx, y: vy },
+        v: VL { x: vx, y: vy },
         w,
         touched,
-        dp: V4 { x: dpx, y: dpy },
+        dp: VL { x: dpx, y: dpy },
         dq_s,
     }
 }
@@ -232,12 +239,12 @@ fn gather<S: StateRead>(states: &[S], idx: &[u32; LANES]) -> WideBody {
 /// first half).
 #[inline(always)]
 fn scatter<S: StateCell>(states: &[S], idx: &[u32; LANES], write: &[bool; LANES], b: &WideBody) {
-    let rows = transpose([b.v.x, b.v.y, b.w, b.touched]);
+    let rows = lanes_to_rows([b.v.x, b.v.y, b.w, b.touched]);
     // Every lane's body is dynamic in most groups (all but those against the ground or a
     // kinematic body): one test of the four flags as a word, not a branch per lane (a
     // single loop testing `all || write[l]` was not split by the compiler: +2 % solve
     // instructions).
-    if u32::from_ne_bytes(write.map(u8::from)) == u32::from_ne_bytes([1; LANES]) {
+    if *write == [true; LANES] {
         for l in 0..LANES {
             states[idx[l] as usize].set_velocity_row(rows[l]);
         }
@@ -253,30 +260,30 @@ fn scatter<S: StateCell>(states: &[S], idx: &[u32; LANES], write: &[bool; LANES]
 /// Lever arms of a pass (the anchors moved to their common point, see
 /// `contact_solver::lever_arms`).
 #[inline(always)]
-fn lever_arms(c: &WideHead, d: V4, r_a: V4, r_b: V4) -> (V4, V4) {
-    let one = F4::splat(1.0);
+fn lever_arms(c: &WideHead, d: VL, r_a: VL, r_b: VL) -> (VL, VL) {
+    let one = FL::splat(1.0);
     (r_a + d.scale(c.split), r_b - d.scale(one - c.split))
 }
 
 /// The relative displacement the lever arms follow (`contact_solver::capped_shift`, lane
 /// by lane; the square root only when some lane is over its cap).
 #[inline(always)]
-fn capped_shift(c: &WideHead, d: V4) -> V4 {
+fn capped_shift(c: &WideHead, d: VL) -> VL {
     let d2 = d.x * d.x + d.y * d.y;
     let over = d2.gt(c.shift_cap2);
     if !over.any() {
         return d;
     }
-    d.scale(over.select((c.shift_cap2 / d2).sqrt(), F4::splat(1.0)))
+    d.scale(over.select((c.shift_cap2 / d2).sqrt(), FL::splat(1.0)))
 }
 
 #[inline(always)]
-fn relative_velocity(a: &WideBody, b: &WideBody, r_a: V4, r_b: V4) -> V4 {
-    let vb = V4 {
+fn relative_velocity(a: &WideBody, b: &WideBody, r_a: VL, r_b: VL) -> VL {
+    let vb = VL {
         x: b.v.x - b.w * r_b.y,
         y: b.v.y + b.w * r_b.x,
     };
-    let va = V4 {
+    let va = VL {
         x: a.v.x - a.w * r_a.y,
         y: a.v.y + a.w * r_a.x,
     };
@@ -284,7 +291,7 @@ fn relative_velocity(a: &WideBody, b: &WideBody, r_a: V4, r_b: V4) -> V4 {
 }
 
 #[inline(always)]
-fn apply(c: &WideHead, a: &mut WideBody, b: &mut WideBody, r_a: V4, r_b: V4, p: V4) {
+fn apply(c: &WideHead, a: &mut WideBody, b: &mut WideBody, r_a: VL, r_b: VL, p: VL) {
     a.v = a.v - p.scale(c.inv_mass_a);
     a.w -= c.inv_i_a * r_a.cross(p);
     b.v = b.v + p.scale(c.inv_mass_b);
@@ -293,7 +300,7 @@ fn apply(c: &WideHead, a: &mut WideBody, b: &mut WideBody, r_a: V4, r_b: V4, p: 
 
 /// The arms' moments about a row direction `u`: (r_a × u, r_b × u).
 #[inline(always)]
-fn moments((r_a, r_b): (V4, V4), u: V4) -> (F4, F4) {
+fn moments((r_a, r_b): (VL, VL), u: VL) -> (FL, FL) {
     (r_a.cross(u), r_b.cross(u))
 }
 
@@ -302,21 +309,21 @@ fn moments((r_a, r_b): (V4, V4), u: V4) -> (F4, F4) {
 /// r_b − (1 − σ) s give r_a × u + σ (s × u) and r_b × u − (1 − σ)(s × u)).
 #[derive(Clone, Copy)]
 struct RowFrame {
-    u: V4,
-    along: F4,
-    shift_a: F4,
-    shift_b: F4,
+    u: VL,
+    along: FL,
+    shift_a: FL,
+    shift_b: FL,
 }
 
 impl RowFrame {
     #[inline(always)]
-    fn new(h: &WideHead, d: V4, shift: V4, u: V4) -> RowFrame {
+    fn new(h: &WideHead, d: VL, shift: VL, u: VL) -> RowFrame {
         let su = shift.cross(u);
         RowFrame {
             u,
             along: d.dot(u),
             shift_a: h.split * su,
-            shift_b: (F4::splat(1.0) - h.split) * su,
+            shift_b: (FL::splat(1.0) - h.split) * su,
         }
     }
 
@@ -324,13 +331,13 @@ impl RowFrame {
     /// the first-order displacement of its material points along `u` [m]
     /// (`contact_solver::RowFrame::point`: d·u + sin Δθ_b (r_b × u) − sin Δθ_a (r_a × u)).
     #[inline(always)]
-    fn point(&self, a: &WideBody, b: &WideBody, r_a: V4, r_b: V4) -> ((F4, F4), F4) {
+    fn point(&self, a: &WideBody, b: &WideBody, r_a: VL, r_b: VL) -> ((FL, FL), FL) {
         self.point_of(a, b, moments((r_a, r_b), self.u))
     }
 
     /// [`RowFrame::point`] from the anchors' moments about `u`, (r_a × u, r_b × u).
     #[inline(always)]
-    fn point_of(&self, a: &WideBody, b: &WideBody, (ma, mb): (F4, F4)) -> ((F4, F4), F4) {
+    fn point_of(&self, a: &WideBody, b: &WideBody, (ma, mb): (FL, FL)) -> ((FL, FL), FL) {
         let disp = self.along + b.dq_s * mb - a.dq_s * ma;
         ((ma + self.shift_a, mb - self.shift_b), disp)
     }
@@ -341,14 +348,14 @@ impl RowFrame {
 /// is with fewer operations and two registers per point instead of four
 /// (`contact_solver::row_speed`, the same expression).
 #[inline(always)]
-fn row_speed(a: &WideBody, b: &WideBody, u: V4, m: (F4, F4)) -> F4 {
+fn row_speed(a: &WideBody, b: &WideBody, u: VL, m: (FL, FL)) -> FL {
     (b.v - a.v).dot(u) + b.w * m.1 - a.w * m.0
 }
 
 /// Applies the impulse `lambda` along a row direction `u` at arms of moments `m`:
 /// −u·λ to A, +u·λ to B (`contact_solver::apply_row`, the same expression).
 #[inline(always)]
-fn apply_row(c: &WideHead, a: &mut WideBody, b: &mut WideBody, u: V4, m: (F4, F4), lambda: F4) {
+fn apply_row(c: &WideHead, a: &mut WideBody, b: &mut WideBody, u: VL, m: (FL, FL), lambda: FL) {
     a.v = a.v - u.scale(c.inv_mass_a * lambda);
     a.w -= c.inv_i_a * (m.0 * lambda);
     b.v = b.v + u.scale(c.inv_mass_b * lambda);
@@ -358,10 +365,10 @@ fn apply_row(c: &WideHead, a: &mut WideBody, b: &mut WideBody, u: V4, m: (F4, F4
 /// The friction row's anchors: the middle of a two-point patch, else the single point
 /// (`contact_solver::build_constraint`'s patch row; the same expression).
 #[inline(always)]
-fn friction_arms(h: &WideHead) -> (V4, V4) {
+fn friction_arms(h: &WideHead) -> (VL, VL) {
     let [p0, p1] = &h.points;
-    let mid = |p: V4, q: V4| (p + q).scale(F4::splat(0.5));
-    let pick = |p: V4, q: V4| V4 {
+    let mid = |p: VL, q: VL| (p + q).scale(FL::splat(0.5));
+    let pick = |p: VL, q: VL| VL {
         x: h.two_points.select(p.x, q.x),
         y: h.two_points.select(p.y, q.y),
     };
@@ -371,28 +378,28 @@ fn friction_arms(h: &WideHead) -> (V4, V4) {
 /// The share of the row's friction impulse point `i` carries (½ each of two points, all of
 /// one; an empty lane's impulse is zero, whatever its share).
 #[inline(always)]
-fn tangent_share(h: &WideHead, i: usize) -> F4 {
-    let half = F4::splat(0.5);
+fn tangent_share(h: &WideHead, i: usize) -> FL {
+    let half = FL::splat(0.5);
     if i == 0 {
-        h.two_points.select(half, F4::splat(1.0))
+        h.two_points.select(half, FL::splat(1.0))
     } else {
-        h.two_points.select(half, F4::ZERO)
+        h.two_points.select(half, FL::ZERO)
     }
 }
 
 /// Lanes with a static side (index 0): their contacts are twice as stiff (Box2D v3's
 /// static softness, `contact_solver::build_constraint`).
 #[inline(always)]
-fn static_lanes(h: &WideHead) -> M4 {
-    M4::either_zero(h.index_a, h.index_b)
+fn static_lanes(h: &WideHead) -> ML {
+    ML::either_zero(h.index_a, h.index_b)
 }
 
 /// The softness of each lane: (bias rate, mass scale, impulse scale).
 #[inline(always)]
-fn lane_softness(h: &WideHead, soft: &StepSoftness) -> (F4, F4, F4) {
+fn lane_softness(h: &WideHead, soft: &StepSoftness) -> (FL, FL, FL) {
     let fixed = static_lanes(h);
     let (s, c) = (&soft.static_contact, &soft.contact);
-    let pick = |x: f32, y: f32| fixed.select(F4::splat(x), F4::splat(y));
+    let pick = |x: f32, y: f32| fixed.select(FL::splat(x), FL::splat(y));
     (
         pick(s.bias_rate, c.bias_rate),
         pick(s.mass_scale, c.mass_scale),
@@ -431,7 +438,7 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
     }
     let turn = shift.cross(total);
     let moment_a = arms_a + c.split * turn;
-    let moment_b = arms_b - (F4::splat(1.0) - c.split) * turn;
+    let moment_b = arms_b - (FL::splat(1.0) - c.split) * turn;
     a.v = a.v - total.scale(c.inv_mass_a);
     a.w -= c.inv_i_a * moment_a;
     b.v = b.v + total.scale(c.inv_mass_b);
@@ -458,13 +465,13 @@ pub(crate) fn restitution<S: StateCell>(
     cold: &WideCold,
     states: &[S],
 ) {
-    let zero = F4::ZERO;
-    let e = F4::new(cold.restitution);
-    let minus_threshold = -F4::new(cold.restitution_threshold);
+    let zero = FL::ZERO;
+    let e = FL::new(cold.restitution);
+    let minus_threshold = -FL::new(cold.restitution_threshold);
     // `contact_solver::bounces` of each point (absent points never bounce).
-    let bounces: [M4; 2] = core::array::from_fn(|i| {
+    let bounces: [ML; 2] = core::array::from_fn(|i| {
         let p = &w.points[i];
-        M4::from_bools(cold.count.map(|c| c as usize > i))
+        ML::from_bools(cold.count.map(|c| c as usize > i))
             & e.gt(zero)
             & minus_threshold.ge(p.approach)
             & p.max_normal_impulse.gt(zero)
@@ -482,7 +489,7 @@ pub(crate) fn restitution<S: StateCell>(
     // Point `i` takes the impulse `new` in the lanes of `m` (elsewhere not even a zero's
     // sign changes).
     let commit =
-        |h: &mut WideHead, w: &mut WideContact, m: M4, i: usize, new: F4, a: &mut WideBody, b: &mut WideBody| {
+        |h: &mut WideHead, w: &mut WideContact, m: ML, i: usize, new: FL, a: &mut WideBody, b: &mut WideBody| {
             let lam = h.points[i].normal_impulse;
             let delta = new - lam;
             let (mut a2, mut b2) = (*a, *b);
@@ -497,7 +504,7 @@ pub(crate) fn restitution<S: StateCell>(
     // Both points of a face bounce: the 2×2 block (`contact_solver::solve_block` with
     // mass scale 1 and impulse scale 0), where it has a solution.
     let face = bounces[0] & bounces[1] & w.block;
-    let mut solved = M4::default();
+    let mut solved = ML::default();
     if face.any() {
         let (lam0, lam1) = (h.points[0].normal_impulse, h.points[1].normal_impulse);
         let (pre0, pre1) = (w.points[0].preload, w.points[1].preload);
@@ -505,9 +512,9 @@ pub(crate) fn restitution<S: StateCell>(
         let rhs1 = normal_velocity(&a, &b, 1) + e * w.points[1].approach;
         let (k11, k12, k22) = (w.k11, w.k12, w.k22);
         let (i11, i12, i22) = (dv.i11, dv.i12, dv.i22);
-        let (one, none) = (F4::splat(1.0), F4::ZERO);
-        let soft0 = |rd: F4| lam0 + one * rd - none * (lam0 - pre0);
-        let soft1 = |rd: F4| lam1 + one * rd - none * (lam1 - pre1);
+        let (one, none) = (FL::splat(1.0), FL::ZERO);
+        let soft0 = |rd: FL| lam0 + one * rd - none * (lam0 - pre0);
+        let soft1 = |rd: FL| lam1 + one * rd - none * (lam1 - pre1);
         let xa0 = soft0(-(i11 * rhs0 + i12 * rhs1));
         let xa1 = soft1(-(i12 * rhs0 + i22 * rhs1));
         let ok_a = xa0.ge(zero) & xa1.ge(zero);
@@ -538,13 +545,13 @@ pub(crate) fn restitution<S: StateCell>(
         let (r_a, r_b) = arms[i];
         let (ra, rb) = (r_a.cross(n), r_b.cross(n));
         let k = h.inv_mass_a + h.inv_mass_b + h.inv_i_a * ra * ra + h.inv_i_b * rb * rb;
-        let normal_mass = k.gt(zero).select(F4::splat(1.0) / k, zero);
+        let normal_mass = k.gt(zero).select(FL::splat(1.0) / k, zero);
         let mut impulse = -normal_mass * (vn + e * w.points[i].approach);
         // The energy cap: λ ≤ m_n (−vn + √(vn² + 2 room / m_n)), room = KE₀ − KE.
         let capped = impulse.gt(zero) & normal_mass.gt(zero);
         if (capped & m).any() {
-            let room = F4::new(cold.kinetic_energy) - kinetic_energy(h, &a, &b);
-            let disc = vn * vn + F4::splat(2.0) * room / normal_mass;
+            let room = FL::new(cold.kinetic_energy) - kinetic_energy(h, &a, &b);
+            let disc = vn * vn + FL::splat(2.0) * room / normal_mass;
             let max = disc.gt(zero).select(normal_mass * (-vn + disc.sqrt()), zero);
             impulse = capped.select(impulse.min(max.max(zero)), impulse);
         }
@@ -557,9 +564,9 @@ pub(crate) fn restitution<S: StateCell>(
 
 /// `x`'s velocities in the lanes of `m`, `y`'s elsewhere.
 #[inline(always)]
-fn select_velocity(m: M4, x: &WideBody, y: &WideBody) -> WideBody {
+fn select_velocity(m: ML, x: &WideBody, y: &WideBody) -> WideBody {
     WideBody {
-        v: V4 {
+        v: VL {
             x: m.select(x.v.x, y.v.x),
             y: m.select(x.v.y, y.v.y),
         },
@@ -571,9 +578,9 @@ fn select_velocity(m: M4, x: &WideBody, y: &WideBody) -> WideBody {
 /// The pair's kinetic energy [J] in each lane (`contact_solver::kinetic_energy_of`, the
 /// same expression).
 #[inline(always)]
-fn kinetic_energy(h: &WideHead, a: &WideBody, b: &WideBody) -> F4 {
-    let (zero, half) = (F4::ZERO, F4::splat(0.5));
-    let part = |inv_m: F4, inv_i: F4, s: &WideBody| {
+fn kinetic_energy(h: &WideHead, a: &WideBody, b: &WideBody) -> FL {
+    let (zero, half) = (FL::ZERO, FL::splat(0.5));
+    let part = |inv_m: FL, inv_i: FL, s: &WideBody| {
         let lin = inv_m
             .gt(zero)
             .select(half * (s.v.x * s.v.x + s.v.y * s.v.y) / inv_m, zero);
@@ -597,15 +604,15 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
     dv: &WideDerived,
     a: &mut WideBody,
     b: &mut WideBody,
-    d: V4,
-    shift: V4,
+    d: VL,
+    shift: VL,
     ctx: &StepContext,
-    (bias_rate, mass_scale, impulse_scale): (F4, F4, F4),
-) -> (F4, F4) {
+    (bias_rate, mass_scale, impulse_scale): (FL, FL, FL),
+) -> (FL, FL) {
     let n = h.normal;
-    let zero = F4::ZERO;
-    let one = F4::splat(1.0);
-    let push = F4::splat(ctx.push_speed);
+    let zero = FL::ZERO;
+    let one = FL::splat(1.0);
+    let push = FL::splat(ctx.push_speed);
     let frame = RowFrame::new(h, d, shift, n);
     // Each point's arm moments about the normal (`WideDerived::normal_moments`, through
     // `RowFrame::point_of`).
@@ -625,7 +632,7 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
         } else {
             (zero, one, zero)
         };
-        bias[i] = speculative.select(s * F4::splat(ctx.inv_h), soft_bias);
+        bias[i] = speculative.select(s * FL::splat(ctx.inv_h), soft_bias);
         ms[i] = speculative.select(one, soft_ms);
         is[i] = speculative.select(zero, soft_is);
         vn[i] = row_speed(a, b, n, rn[i]);
@@ -637,7 +644,7 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
     // A point's sequential row (contact_solver::normal_row): from impulse `lam`, with
     // normal mass `mass`, right-hand side `rhs` and its softness, clamped at zero.
     let seq =
-        |lam: F4, mass: F4, ms: F4, rhs: F4, is: F4, pre: F4| (lam + (-(mass * ms * rhs) - is * (lam - pre))).max(zero);
+        |lam: FL, mass: FL, ms: FL, rhs: FL, is: FL, pre: FL| (lam + (-(mass * ms * rhs) - is * (lam - pre))).max(zero);
     let (new0, new1) = if POINTS == 1 {
         // The sequential row of the first point (the general path's `seq0`).
         let seq0 = seq(lam0, p0.normal_mass, ms[0], rhs0, is[0], pre0);
@@ -646,8 +653,8 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
     } else {
         // The 2×2 block LCP (contact_solver::solve_block), all four cases in every lane.
         let rhs1 = vn[1] + bias[1];
-        let soft0 = |rd: F4| lam0 + ms[0] * rd - is[0] * (lam0 - pre0);
-        let soft1 = |rd: F4| lam1 + ms[1] * rd - is[1] * (lam1 - pre1);
+        let soft0 = |rd: FL| lam0 + ms[0] * rd - is[0] * (lam0 - pre0);
+        let soft1 = |rd: FL| lam1 + ms[1] * rd - is[1] * (lam1 - pre1);
         // K⁻¹ (zero where the block does not apply).
         let (i11, i12, i22) = (dv.i11, dv.i12, dv.i22);
         let xa0 = soft0(-(i11 * rhs0 + i12 * rhs1));
@@ -736,9 +743,9 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     let d = b.dp - a.dp;
     let shift = capped_shift(h, d);
     let n = h.normal;
-    let zero = F4::ZERO;
-    let one = F4::splat(1.0);
-    let push = F4::splat(ctx.push_speed);
+    let zero = FL::ZERO;
+    let one = FL::splat(1.0);
+    let push = FL::splat(ctx.push_speed);
     // (bias rate, mass scale, impulse scale); the friction row's bias reads the rate.
     let rows = if USE_BIAS {
         lane_softness(h, soft)
@@ -774,7 +781,7 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     let limit = c.mu * (new0 + new1);
     let vt = row_speed(&a, &b, t, m) - c.tangent_speed;
     let fbias = if USE_BIAS {
-        let drift = disp + c.base_drift - c.tangent_speed * F4::splat(elapsed);
+        let drift = disp + c.base_drift - c.tangent_speed * FL::splat(elapsed);
         let rate = bias_rate * drift;
         (c.stick & limit.gt(zero)).select(rate.clamp(-push, push), zero)
     } else {
@@ -827,9 +834,9 @@ pub(crate) fn build_group<S: StateRead>(
     states: &[S],
 ) {
     let warm = ctx.warm_starting;
-    let zero = F4::ZERO;
-    let one = F4::splat(1.0);
-    let half = F4::splat(0.5);
+    let zero = FL::ZERO;
+    let one = FL::splat(1.0);
+    let half = FL::splat(0.5);
     // Written in place (a 1 KiB group built on the stack and copied costs more), every
     // field of `head` and `w` once, with no clearing first: clearing them was two
     // `memset` calls a group, 84 instructions of large_pyramid's ~1 200 (the test
@@ -852,47 +859,47 @@ pub(crate) fn build_group<S: StateRead>(
             (input, b)
         })
     });
-    let present = M4::from_bools(lanes.map(|lane| lane.is_some()));
+    let present = ML::from_bools(lanes.map(|lane| lane.is_some()));
     // Each lane's bodies (an empty lane: the static body, not written back).
     let (index_a, index_b) = (read.map(|(_, b)| b.index_a), read.map(|(_, b)| b.index_b));
     (hd.index_a, hd.index_b) = (index_a, index_b);
     let each = |f: &dyn Fn(&ContactInput, &ConstraintBodies) -> f32| {
-        F4::new(core::array::from_fn(|l| f(read[l].0, read[l].1)))
+        FL::new(core::array::from_fn(|l| f(read[l].0, read[l].1)))
     };
     let count_of = |input: &ContactInput| input.count.min(2);
     // Fields that lie side by side in a candidate come as one 16-byte row per lane,
     // transposed into four lanes of each (zeros in an empty lane): eight shuffles instead
     // of sixteen single-lane loads and inserts per row.
-    let columns = |row: &dyn Fn(&ContactInput, &ConstraintBodies) -> [f32; LANES]| {
-        transpose(core::array::from_fn(|l| F4::new(row(read[l].0, read[l].1))))
+    let columns = |row: &dyn Fn(&ContactInput, &ConstraintBodies) -> [f32; 4]| {
+        rows_to_lanes(core::array::from_fn(|l| F4::new(row(read[l].0, read[l].1))))
     };
     let [cax, cay, cbx, cby] = columns(&|_, b| b.centre_row());
-    let (center_a, center_b) = (V4 { x: cax, y: cay }, V4 { x: cbx, y: cby });
+    let (center_a, center_b) = (VL { x: cax, y: cay }, VL { x: cbx, y: cby });
     let [ma, ia, mb, ib] = columns(&|_, b| b.mass_row());
     // Which sides are written back: `ConstraintBodies::moving`, four lanes at once from
     // the masses' columns.
-    let moving = |m: F4, i: F4, index: [u32; LANES]| ((m.gt(zero) | i.gt(zero)) & !M4::zero_lanes(index)).to_bools();
+    let moving = |m: FL, i: FL, index: [u32; LANES]| ((m.gt(zero) | i.gt(zero)) & !ML::zero_lanes(index)).to_bools();
     hd.write_a = moving(ma, ia, index_a);
     hd.write_b = moving(mb, ib, index_b);
     // Each point's (x, y, separation, normal impulse); kept where the lane has the point.
-    let point_rows: [[F4; 4]; 2] = core::array::from_fn(|i| columns(&|input, _| input.points[i].row()));
+    let point_rows: [[FL; 4]; 2] = core::array::from_fn(|i| columns(&|input, _| input.points[i].row()));
     let counts = read.map(|(input, _)| count_of(input) as u32);
-    let has: [M4; 2] = core::array::from_fn(|i| M4::above(counts, i as u32));
-    let point: [V4; 2] = core::array::from_fn(|i| V4 {
+    let has: [ML; 2] = core::array::from_fn(|i| ML::above(counts, i as u32));
+    let point: [VL; 2] = core::array::from_fn(|i| VL {
         x: has[i].select(point_rows[i][0], zero),
         y: has[i].select(point_rows[i][1], zero),
     });
     // Each point's (friction impulse, preload, drift, flags), and its flags as masks (none
     // where the lane lacks the point): the flags come in the transpose with the floats, one
     // word a lane, instead of masks assembled from each lane's bytes.
-    let state_rows: [[F4; 4]; 2] = core::array::from_fn(|i| columns(&|input, _| input.points[i].state_row()));
-    let stick_in: [M4; 2] = core::array::from_fn(|i| has[i] & state_rows[i][3].bits_set(INPUT_STICK));
-    let fresh: [M4; 2] = core::array::from_fn(|i| has[i] & state_rows[i][3].bits_set(INPUT_FRESH));
+    let state_rows: [[FL; 4]; 2] = core::array::from_fn(|i| columns(&|input, _| input.points[i].state_row()));
+    let stick_in: [ML; 2] = core::array::from_fn(|i| has[i] & state_rows[i][3].bits_set(INPUT_STICK));
+    let fresh: [ML; 2] = core::array::from_fn(|i| has[i] & state_rows[i][3].bits_set(INPUT_FRESH));
     // A sticking point's drift carries over (not a fresh one's). Chosen by masks, not a branch
     // per lane: which points stick is data (the branch had missed 3 100 times a step in
     // tumbler, 6 % of its misses).
-    let base_drift: [F4; 2] = core::array::from_fn(|i| (stick_in[i] & !fresh[i]).select(state_rows[i][2], zero));
-    hd.normal = V4 {
+    let base_drift: [FL; 2] = core::array::from_fn(|i| (stick_in[i] & !fresh[i]).select(state_rows[i][2], zero));
+    hd.normal = VL {
         x: each(&|input, _| input.normal.x),
         y: each(&|input, _| input.normal.y),
     };
@@ -919,13 +926,13 @@ pub(crate) fn build_group<S: StateRead>(
             wp.approach,
         ) = (zero, zero, zero, zero);
     }
-    (out.total_tangent_impulse, out.saturated) = (zero, M4::default());
+    (out.total_tangent_impulse, out.saturated) = (zero, ML::default());
     // Summed as `pack_state` sums (`Iterator::sum` of f32 starts at −0.0, and −0.0 + x is
     // x: the same bits, the same sign of a zero sum), without a loop; +0.0 in an empty lane.
     // Four lanes at once (a `match` on each lane's count was a branch per lane).
     let friction_impulse = |i: usize| if warm { state_rows[i][0] } else { zero };
     let (t0, t1) = (friction_impulse(0), friction_impulse(1));
-    let summed = has[1].select(t0 + t1, has[0].select(t0, F4::splat(-0.0)));
+    let summed = has[1].select(t0 + t1, has[0].select(t0, FL::splat(-0.0)));
     hd.tangent_impulse = present.select(summed, zero);
     c.base_drift = base_drift.map(|d| *d);
     let [mu_s, mu_d, restitution, threshold] = columns(&|input, _| input.material_row());
@@ -940,7 +947,7 @@ pub(crate) fn build_group<S: StateRead>(
     let any_restitution = restitution.gt(zero).any();
     (c.any_restitution, hd.any_restitution) = (any_restitution, any_restitution);
     hd.any_rolling = (rolling_resistance.gt(zero) | used_rolling_impulse.ne(zero)).any();
-    let height = point_rows[0][0] * F4::splat(up.x) + point_rows[0][1] * F4::splat(up.y);
+    let height = point_rows[0][0] * FL::splat(up.x) + point_rows[0][1] * FL::splat(up.y);
     c.height = *has[0].select(height, zero);
     for (l, lane) in lanes.iter().enumerate() {
         let Some((contact, input, b)) = *lane else {
@@ -955,9 +962,9 @@ pub(crate) fn build_group<S: StateRead>(
     }
     // Each point's friction state: its own, but a new point's is decided from the bodies'
     // velocities (`fresh_point_sticks`), lane by lane where a lane has one.
-    c.fresh = fresh.map(M4::to_bools);
+    c.fresh = fresh.map(ML::to_bools);
     let stick = if (fresh[0] | fresh[1]).any() {
-        let mut stick = stick_in.map(M4::to_bools);
+        let mut stick = stick_in.map(ML::to_bools);
         for (l, lane) in lanes.iter().enumerate() {
             let Some((_, input, b)) = *lane else {
                 continue;
@@ -975,9 +982,9 @@ pub(crate) fn build_group<S: StateRead>(
             }
         }
         c.stick = stick;
-        stick.map(M4::from_stored_bools)
+        stick.map(ML::from_stored_bools)
     } else {
-        c.stick = stick_in.map(M4::to_bools);
+        c.stick = stick_in.map(ML::to_bools);
         stick_in
     };
     // The row sticks where every point it has sticks (an empty lane: a sticking, empty
@@ -988,18 +995,18 @@ pub(crate) fn build_group<S: StateRead>(
     let n = hd.normal;
     let t = n.right_perp();
     // k = m_a⁻¹ + m_b⁻¹ + I_a⁻¹ (r_a × d)² + I_b⁻¹ (r_b × d)² (effective_mass_inv).
-    let k_of = |r_a: V4, r_b: V4, d: V4| {
+    let k_of = |r_a: VL, r_b: VL, d: VL| {
         let (ra, rb) = (r_a.cross(d), r_b.cross(d));
         ma + mb + ia * ra * ra + ib * rb * rb
     };
-    let inv_or_zero = |k: F4| k.gt(zero).select(one / k, zero);
+    let inv_or_zero = |k: FL| k.gt(zero).select(one / k, zero);
     let sum = ma + mb;
     hd.split = sum.gt(zero).select(mb / sum, half);
     hd.shift_cap2 = wide_shift_cap2(ma, ia, mb, ib);
-    let mut arms = [(V4::default(), V4::default()); 2];
+    let mut arms = [(VL::default(), VL::default()); 2];
     let mut kn = [zero; 2];
     for i in 0..2 {
-        let keep = |v: V4| V4 {
+        let keep = |v: VL| VL {
             x: has[i].select(v.x, zero),
             y: has[i].select(v.y, zero),
         };
@@ -1025,7 +1032,7 @@ pub(crate) fn build_group<S: StateRead>(
     let (e0, e1) = (rb0.cross(n), rb1.cross(n));
     let k12 = ma + mb + ia * c0 * c1 + ib * e0 * e1;
     let det = k11 * k22 - k12 * k12;
-    let block = two & (k11 * k11).lt(F4::splat(1000.0) * det) & det.gt(zero);
+    let block = two & (k11 * k11).lt(FL::splat(1000.0) * det) & det.gt(zero);
     let inv = one / det;
     out.block = block;
     out.k11 = block.select(k11, zero);
@@ -1038,11 +1045,11 @@ pub(crate) fn build_group<S: StateRead>(
 /// `contact_solver::shift_cap2` four lanes at once (the same quotients and minimum; the
 /// scalar form's two divisions per lane were a fourteenth of the wide build).
 #[inline(always)]
-fn wide_shift_cap2(ma: F4, ia: F4, mb: F4, ib: F4) -> F4 {
-    let (zero, max) = (F4::ZERO, F4::splat(f32::MAX));
-    let side = |inv_m: F4, inv_i: F4| inv_i.gt(zero).select(inv_m / inv_i, max);
+fn wide_shift_cap2(ma: FL, ia: FL, mb: FL, ib: FL) -> FL {
+    let (zero, max) = (FL::ZERO, FL::splat(f32::MAX));
+    let side = |inv_m: FL, inv_i: FL| inv_i.gt(zero).select(inv_m / inv_i, max);
     let rho2 = side(ma, ia).min(side(mb, ib));
-    rho2.lt(max).select(F4::splat(0.25) * rho2, max)
+    rho2.lt(max).select(FL::splat(0.25) * rho2, max)
 }
 
 /// What the store writes into one contact: its points' persistent states and the rolling
@@ -1097,33 +1104,33 @@ pub(crate) fn store_group<S: StateRead>(
     let n = h.normal;
     let t = n.right_perp();
     let frame = RowFrame::new(h, d, shift, t);
-    let mut vt = [F4::ZERO; 2];
-    let mut disp = [F4::ZERO; 2];
+    let mut vt = [FL::ZERO; 2];
+    let mut disp = [FL::ZERO; 2];
     for i in 0..2 {
         let p = &h.points[i];
         let (m, along) = frame.point(&a, &b, p.r_a, p.r_b);
         (vt[i], disp[i]) = (row_speed(&a, &b, t, m) - w.tangent_speed, along);
     }
     // Four lanes at once; every expression is the scalar store's, in its order.
-    let zero = F4::ZERO;
-    let has0 = M4::from_nonzero_bytes(cold.count);
+    let zero = FL::ZERO;
+    let has0 = ML::from_nonzero_bytes(cold.count);
     let (two, share) = (h.two_points, tangent_share(h, 0));
     let (tangent, total_tangent) = (share * h.tangent_impulse, share * w.total_tangent_impulse);
     // Sums over the points from 0.0 (the scalar loop's start).
-    let sum_over = |x0: F4, x1: F4| {
+    let sum_over = |x0: FL, x1: FL| {
         let first = zero + x0;
         two.select(first + x1, has0.select(first, zero))
     };
     let (n0, n1) = (h.points[0].normal_impulse, h.points[1].normal_impulse);
     let (sum_t, sum_n) = (sum_over(tangent, tangent), sum_over(n0, n1));
-    let patch_saturated = sum_t.abs().ge(F4::splat(0.999) * F4::new(cold.mu_s) * sum_n) & has0 & w.saturated;
+    let patch_saturated = sum_t.abs().ge(FL::splat(0.999) * FL::new(cold.mu_s) * sum_n) & has0 & w.saturated;
     // Only read where there are two points (`Sum` from −0.0: the plain sum of the two).
     let sum_total_t = total_tangent + total_tangent;
     let (tn0, tn1) = (w.points[0].total_normal_impulse, w.points[1].total_normal_impulse);
     let sum_total_n = tn0 + tn1;
-    let stick_speed = F4::splat(ctx.stick_speed);
-    let restitution = F4::new(cold.restitution);
-    let threshold = -F4::new(cold.restitution_threshold);
+    let stick_speed = FL::splat(ctx.stick_speed);
+    let restitution = FL::new(cold.restitution);
+    let threshold = -FL::new(cold.restitution_threshold);
     // Each point's states, four lanes; `StoredGroup::new` transposes them into each
     // lane's two rows, which are written straight into the contact's record, not into a
     // `PointState` built on the stack first and copied (filling a default-made array field
@@ -1133,8 +1140,8 @@ pub(crate) fn store_group<S: StateRead>(
         let (wp, normal) = (&w.points[i], h.points[i].normal_impulse);
         let (total_normal, max) = (wp.total_normal_impulse, wp.max_normal_impulse);
         let (was_stick, fresh) = (
-            M4::from_stored_bools(cold.stick[i]),
-            M4::from_stored_bools(cold.fresh[i]),
+            ML::from_stored_bools(cold.stick[i]),
+            ML::from_stored_bools(cold.fresh[i]),
         );
         let slip_speed = vt[i].abs();
         let loaded = max.gt(zero);
@@ -1146,14 +1153,14 @@ pub(crate) fn store_group<S: StateRead>(
         let total_tangent_out =
             (two & sum_total_n.gt(zero)).select(sum_total_t * total_normal / sum_total_n, total_tangent);
         let drift = (stick & was_stick & loaded).select(
-            disp[i] + F4::new(cold.base_drift[i]) - w.tangent_speed * F4::splat(ctx.dt),
+            disp[i] + FL::new(cold.base_drift[i]) - w.tangent_speed * FL::splat(ctx.dt),
             zero,
         );
         // next_preload, with `bounces` of the restitution pass.
         let approach = wp.approach;
         let bounced = restitution.gt(zero) & threshold.ge(approach) & max.gt(zero);
         let released = zero.ge(max) | (fresh & bounced);
-        let kept = normal.lt(F4::splat(0.5) * wp.preload).select(zero, wp.preload);
+        let kept = normal.lt(FL::splat(0.5) * wp.preload).select(zero, wp.preload);
         let preload = released.select(zero, fresh.select(normal, kept));
         StoredPoint {
             normal,
@@ -1171,14 +1178,14 @@ pub(crate) fn store_group<S: StateRead>(
 
 /// One point's stored states in the four lanes of a group ([`store_group`]).
 pub(crate) struct StoredPoint {
-    normal: F4,
-    total_normal: F4,
-    total_tangent: F4,
-    max: F4,
-    stick: M4,
-    drift: F4,
-    slip_speed: F4,
-    preload: F4,
+    normal: FL,
+    total_normal: FL,
+    total_tangent: FL,
+    max: FL,
+    stick: ML,
+    drift: FL,
+    slip_speed: FL,
+    preload: FL,
 }
 
 /// What the store writes into a group's four contacts ([`store_group`]), lane by lane:
@@ -1195,7 +1202,7 @@ pub(crate) struct StoredGroup {
     /// writes read one lane at a time, and a mask's lane was copied out of it through the
     /// stack at every read).
     stick: [[bool; LANES]; 2],
-    rolling_impulse: F4,
+    rolling_impulse: FL,
     /// The manifolds' point counts.
     count: [u8; LANES],
 }
@@ -1204,11 +1211,11 @@ impl StoredGroup {
     /// The lanes of `points` as rows ([`StoredGroup::rows`]); `tangent` is each point's
     /// friction impulse (the row's, shared by the points).
     #[inline(always)]
-    fn new(points: [StoredPoint; 2], tangent: F4, rolling_impulse: F4, count: [u8; LANES]) -> StoredGroup {
+    fn new(points: [StoredPoint; 2], tangent: FL, rolling_impulse: FL, count: [u8; LANES]) -> StoredGroup {
         let rows_of = |p: &StoredPoint| {
             (
-                transpose([p.normal, tangent, p.drift, p.preload]),
-                transpose([p.total_normal, p.total_tangent, p.max, p.slip_speed]),
+                lanes_to_rows([p.normal, tangent, p.drift, p.preload]),
+                lanes_to_rows([p.total_normal, p.total_tangent, p.max, p.slip_speed]),
             )
         };
         let ((a0, b0), (a1, b1)) = (rows_of(&points[0]), rows_of(&points[1]));
@@ -1565,6 +1572,11 @@ mod tests {
         }
     }
 
+    /// Four lanes' values, the lanes after them (with eight lanes) 0.
+    fn lanes_from(first: [f32; 4]) -> FL {
+        FL::new(core::array::from_fn(|l| first.get(l).copied().unwrap_or(0.0)))
+    }
+
     /// The lanes of `cases` in order, empty after them.
     fn lanes_of(cases: &[(u32, ContactInput, ConstraintBodies)]) -> [LaneInput<'_>; LANES] {
         core::array::from_fn(|l| cases.get(l).map(|(c, i, b)| (*c, i, b)))
@@ -1613,8 +1625,8 @@ mod tests {
         // make it again.
         let (mut rh, mut r, mut rcold) = (h, w, cold);
         let mut rdv = WideDerived {
-            i12: F4::splat(7.0),
-            normal_moments: [(F4::splat(7.0), F4::splat(7.0)); 2],
+            i12: FL::splat(7.0),
+            normal_moments: [(FL::splat(7.0), FL::splat(7.0)); 2],
             ..dv
         };
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
@@ -1720,9 +1732,9 @@ mod tests {
     /// added to either record does not compile here until it is poisoned too.
     fn poisoned(k: usize) -> (WideHead, WideContact) {
         let (x, flag, index) = ([7.5, -7.5][k], k == 0, [7, 9][k]);
-        let x = F4::splat(x);
-        let v = V4 { x, y: x };
-        let m = M4::new([[0x0101_0101, u32::MAX][k]; LANES]);
+        let x = FL::splat(x);
+        let v = VL { x, y: x };
+        let m = ML::new([[0x0101_0101, u32::MAX][k]; LANES]);
         let hp = HeadPoint {
             r_a: v,
             r_b: v,
@@ -1798,7 +1810,8 @@ mod tests {
         // lies at x > 0), the second of a two-point lane slides, the one-point lane's
         // absent point neither; lane 1's side A is not written back, its side B is.
         assert_eq!(cold.fresh, [[false; LANES]; 2]);
-        assert_eq!(cold.stick, [[true, true, true, false], [false; LANES]]);
+        let first: [bool; LANES] = core::array::from_fn(|l| l < 3);
+        assert_eq!(cold.stick, [first, [false; LANES]]);
         assert!(!h.write_a[1] && h.write_b[1] && h.write_a[0] && h.write_b[2]);
     }
 
@@ -1864,7 +1877,7 @@ mod tests {
             warm_starting: false,
             ..f.ctx
         };
-        let lanes: [LaneInput<'_>; LANES] = [None, Some((id, &rolling, b)), None, None];
+        let lanes: [LaneInput<'_>; LANES] = core::array::from_fn(|l| (l == 1).then_some((id, &rolling, b)));
         let (h, ..) = built(lanes, f.up, &cold_ctx, &f.states);
         assert!(!h.any_rolling);
     }
@@ -2063,12 +2076,7 @@ mod tests {
             (2, input(1, false, 0.5, 0.0), bodies(0, 3)),
             (3, input(2, false, 0.3, 0.0), bodies(4, 5)),
         ];
-        let lanes: [LaneInput<'_>; LANES] = [
-            Some((cases[0].0, &cases[0].1, &cases[0].2)),
-            Some((cases[1].0, &cases[1].1, &cases[1].2)),
-            Some((cases[2].0, &cases[2].1, &cases[2].2)),
-            None,
-        ];
+        let lanes = lanes_of(&cases);
         let (mut h, mut w, mut cold, dv) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
         // Impact speeds and loads as the substeps would leave them: every point bounces but
         // lane 2's second (slower than the 1 m/s threshold); lane 1 had little energy.
@@ -2076,11 +2084,11 @@ mod tests {
             .into_iter()
             .enumerate()
         {
-            w.points[i].approach = F4::new(approach);
-            w.points[i].max_normal_impulse = F4::new([1.0, 1.0, 1.0, 0.0]);
-            w.points[i].total_normal_impulse = F4::new([0.3, 0.2, 0.1, 0.0]);
+            w.points[i].approach = lanes_from(approach);
+            w.points[i].max_normal_impulse = lanes_from([1.0, 1.0, 1.0, 0.0]);
+            w.points[i].total_normal_impulse = lanes_from([0.3, 0.2, 0.1, 0.0]);
         }
-        cold.kinetic_energy = [50.0, 0.2, 50.0, 0.0];
+        cold.kinetic_energy = *lanes_from([50.0, 0.2, 50.0, 0.0]);
         assert!(w.block.lane(0), "lane 0 is a face the block can solve");
         // Scalar: lane by lane, each unpacked, solved and compared.
         let scalar: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();

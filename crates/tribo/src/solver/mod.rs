@@ -924,11 +924,11 @@ fn integrate_positions<S: StateCell>(ctx: &StepContext, sims: &[BodySim], states
     let n = sims.len();
     S::for_each_index(
         states,
-        n.div_ceil(wide::LANES),
-        BODY_CHUNK / wide::LANES,
+        n.div_ceil(wide::LANES4),
+        BODY_CHUNK / wide::LANES4,
         |q, states| {
-            let first = q * wide::LANES;
-            integrate_positions_range(ctx, sims, states, first.max(1)..(first + wide::LANES).min(n));
+            let first = q * wide::LANES4;
+            integrate_positions_range(ctx, sims, states, first.max(1)..(first + wide::LANES4).min(n));
         },
     );
 }
@@ -947,13 +947,13 @@ pub(crate) fn integrate_positions_range<S: StateCell>(
     let h = ctx.h;
     let max_w = max_angular_speed(ctx);
     let mut k = range.start;
-    while k + wide::LANES <= range.end {
-        let (Some(block), Some(block_sims)) = (states.get(k..k + wide::LANES), sims.get(k..k + wide::LANES)) else {
+    while k + wide::LANES4 <= range.end {
+        let (Some(block), Some(block_sims)) = (states.get(k..k + wide::LANES4), sims.get(k..k + wide::LANES4)) else {
             break;
         };
         // The rotation after the turn of the substep, before it is normalised
         // (`Rot::integrate`), from each body's clamped angular velocity.
-        let turned: [(f32, f32); wide::LANES] = core::array::from_fn(|l| {
+        let turned: [(f32, f32); wide::LANES4] = core::array::from_fn(|l| {
             let s = block[l].get();
             let da = h * s.w.clamp(-max_w, max_w);
             (s.dq.c - da * s.dq.s, s.dq.s + da * s.dq.c)
@@ -968,7 +968,7 @@ pub(crate) fn integrate_positions_range<S: StateCell>(
             s.dq = crate::math::Rot { c: qc[l], s: qs[l] };
             state.set(s);
         }
-        k += wide::LANES;
+        k += wide::LANES4;
     }
     for b in k..range.end {
         if let (Some(sim), Some(state)) = (sims.get(b), states.get(b)) {

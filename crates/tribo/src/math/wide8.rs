@@ -1,0 +1,543 @@
+//! Eight-lane floats for the wide contact solver in a build for AVX2 (`-C
+//! target-feature=+avx2`, as Box2D's `BOX2D_AVX2` option): the same operations as
+//! [`super::wide::F4`] and [`super::wide::M4`], each one AVX instruction on a 256-bit
+//! register. Every operation is lane-wise plain IEEE arithmetic (no fused multiply-add, no
+//! approximate reciprocal), so a lane computes bit for bit what the same scalar expression
+//! computes, as with four lanes.
+//!
+//! Used only through [`super::wide::FL`], [`super::wide::ML`] and [`super::wide::VL`],
+//! which are these types in such a build and the four-lane ones otherwise.
+
+use super::wide::F4;
+use core::arch::x86_64::{__m128, __m256, __m256i};
+use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub, SubAssign};
+
+/// Lanes of [`F8`].
+pub(crate) const LANES8: usize = 8;
+
+/// Eight `f32` lanes (read and written as an array through `Deref`).
+#[derive(Clone, Copy)]
+#[repr(C, align(32))]
+pub(crate) struct F8(__m256);
+
+/// Eight lane masks (each all ones = true or all zeros = false).
+#[derive(Clone, Copy)]
+#[repr(C, align(32))]
+pub(crate) struct M8(__m256);
+
+const _: () = assert!(core::mem::size_of::<F8>() == 32 && core::mem::size_of::<M8>() == 32);
+
+/// The AVX and AVX2 intrinsics used here, wrapped as safe functions, and a register's
+/// lanes seen as an array.
+#[allow(unsafe_code)]
+mod avx {
+    pub use core::arch::x86_64::{__m128, __m128i, __m256, __m256i};
+    pub use core::arch::x86_64::{_CMP_GE_OQ, _CMP_GT_OQ, _CMP_LT_OQ, _CMP_NEQ_UQ};
+
+    /// Wraps intrinsics as safe functions.
+    macro_rules! avx2 {
+        ($($name:ident $(<$c:ident>)? ($($a:ident: $t:ty),*) -> $r:ty;)*) => {$(
+            #[inline(always)]
+            pub fn $name$(<const $c: i32>)?($($a: $t),*) -> $r {
+                // SAFETY: this module is compiled only with AVX2 enabled for the whole
+                // build (`cfg(target_feature = "avx2")`), so every CPU the build runs on
+                // has AVX and AVX2; these intrinsics work on values only: they read and
+                // write no memory.
+                unsafe { core::arch::x86_64::$name$(::<$c>)?($($a),*) }
+            }
+        )*};
+    }
+
+    avx2! {
+        _mm256_set1_ps(a: f32) -> __m256;
+        _mm256_set1_epi32(a: i32) -> __m256i;
+        _mm256_setzero_si256() -> __m256i;
+        _mm256_castsi256_ps(a: __m256i) -> __m256;
+        _mm256_castps_si256(a: __m256) -> __m256i;
+        _mm256_cmpeq_epi32(a: __m256i, b: __m256i) -> __m256i;
+        _mm256_cmpgt_epi32(a: __m256i, b: __m256i) -> __m256i;
+        _mm256_and_si256(a: __m256i, b: __m256i) -> __m256i;
+        _mm256_cvtepu8_epi32(a: __m128i) -> __m256i;
+        _mm_cvtsi64_si128(a: i64) -> __m128i;
+        _mm256_add_ps(a: __m256, b: __m256) -> __m256;
+        _mm256_sub_ps(a: __m256, b: __m256) -> __m256;
+        _mm256_mul_ps(a: __m256, b: __m256) -> __m256;
+        _mm256_div_ps(a: __m256, b: __m256) -> __m256;
+        _mm256_sqrt_ps(a: __m256) -> __m256;
+        _mm256_max_ps(a: __m256, b: __m256) -> __m256;
+        _mm256_min_ps(a: __m256, b: __m256) -> __m256;
+        _mm256_and_ps(a: __m256, b: __m256) -> __m256;
+        _mm256_andnot_ps(a: __m256, b: __m256) -> __m256;
+        _mm256_or_ps(a: __m256, b: __m256) -> __m256;
+        _mm256_xor_ps(a: __m256, b: __m256) -> __m256;
+        _mm256_cmp_ps<P>(a: __m256, b: __m256) -> __m256;
+        _mm256_movemask_ps(a: __m256) -> i32;
+        _mm256_unpacklo_ps(a: __m256, b: __m256) -> __m256;
+        _mm256_unpackhi_ps(a: __m256, b: __m256) -> __m256;
+        _mm256_shuffle_ps<P>(a: __m256, b: __m256) -> __m256;
+        _mm256_set_m128(hi: __m128, lo: __m128) -> __m256;
+        _mm256_castps256_ps128(a: __m256) -> __m128;
+        _mm256_extractf128_ps<P>(a: __m256) -> __m128;
+    }
+
+    #[inline(always)]
+    pub fn f(r: &__m256) -> &[f32; 8] {
+        // SAFETY: `__m256` is 32 bytes of eight `f32` lanes in order (lane 0 first),
+        // aligned to 32; every bit pattern is a valid `f32` and `u32`, and the borrow is
+        // the register's.
+        unsafe { &*(r as *const __m256 as *const [f32; 8]) }
+    }
+
+    #[inline(always)]
+    pub fn f_mut(r: &mut __m256) -> &mut [f32; 8] {
+        // SAFETY: as `f`.
+        unsafe { &mut *(r as *mut __m256 as *mut [f32; 8]) }
+    }
+
+    #[inline(always)]
+    pub fn m(r: &__m256) -> &[u32; 8] {
+        // SAFETY: as `f`.
+        unsafe { &*(r as *const __m256 as *const [u32; 8]) }
+    }
+
+    #[inline(always)]
+    pub fn m_mut(r: &mut __m256) -> &mut [u32; 8] {
+        // SAFETY: as `f`.
+        unsafe { &mut *(r as *mut __m256 as *mut [u32; 8]) }
+    }
+
+    /// An array's lanes as a register (a constant expression).
+    pub const fn from_f(a: [f32; 8]) -> __m256 {
+        // SAFETY: same size, every bit pattern valid (see `f`).
+        unsafe { core::mem::transmute::<[f32; 8], __m256>(a) }
+    }
+
+    pub const fn from_m(a: [u32; 8]) -> __m256 {
+        // SAFETY: as `from_f`.
+        unsafe { core::mem::transmute::<[u32; 8], __m256>(a) }
+    }
+
+    /// Eight words as a register.
+    #[inline(always)]
+    pub fn words(a: [u32; 8]) -> __m256i {
+        _mm256_castps_si256(from_m(a))
+    }
+}
+
+use avx::*;
+
+macro_rules! lane_array8 {
+    ($t:ident, $e:ty, $view:ident, $view_mut:ident) => {
+        impl core::ops::Deref for $t {
+            type Target = [$e; LANES8];
+            #[inline(always)]
+            fn deref(&self) -> &[$e; LANES8] {
+                avx::$view(&self.0)
+            }
+        }
+
+        impl core::ops::DerefMut for $t {
+            #[inline(always)]
+            fn deref_mut(&mut self) -> &mut [$e; LANES8] {
+                avx::$view_mut(&mut self.0)
+            }
+        }
+
+        impl PartialEq for $t {
+            fn eq(&self, o: &$t) -> bool {
+                **self == **o
+            }
+        }
+
+        impl core::fmt::Debug for $t {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                write!(f, concat!(stringify!($t), "({:?})"), **self)
+            }
+        }
+    };
+}
+lane_array8!(F8, f32, f, f_mut);
+lane_array8!(M8, u32, m, m_mut);
+
+impl Eq for M8 {}
+
+impl Default for F8 {
+    fn default() -> F8 {
+        F8::ZERO
+    }
+}
+
+impl Default for M8 {
+    fn default() -> M8 {
+        M8::new([0; LANES8])
+    }
+}
+
+impl F8 {
+    pub const ZERO: F8 = F8::new([0.0; LANES8]);
+
+    /// Lanes from an array.
+    #[inline(always)]
+    pub const fn new(a: [f32; LANES8]) -> F8 {
+        F8(from_f(a))
+    }
+
+    #[inline(always)]
+    pub fn splat(x: f32) -> F8 {
+        F8(_mm256_set1_ps(x))
+    }
+
+    /// Lane-wise maximum (`a > b ? a : b`, as `F4::max`).
+    #[inline(always)]
+    pub fn max(self, o: F8) -> F8 {
+        F8(_mm256_max_ps(self.0, o.0))
+    }
+
+    /// Lane-wise minimum (`a < b ? a : b`, as `F4::min`).
+    #[inline(always)]
+    pub fn min(self, o: F8) -> F8 {
+        F8(_mm256_min_ps(self.0, o.0))
+    }
+
+    #[inline(always)]
+    pub fn clamp(self, lo: F8, hi: F8) -> F8 {
+        self.max(lo).min(hi)
+    }
+
+    /// Lane-wise square root (IEEE, as `f32::sqrt`).
+    #[inline(always)]
+    pub fn sqrt(self) -> F8 {
+        F8(_mm256_sqrt_ps(self.0))
+    }
+
+    #[inline(always)]
+    pub fn abs(self) -> F8 {
+        F8(_mm256_and_ps(
+            self.0,
+            _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff)),
+        ))
+    }
+
+    /// `>` (false where either lane is NaN, as SSE's `cmpgtps`).
+    #[inline(always)]
+    pub fn gt(self, o: F8) -> M8 {
+        M8(_mm256_cmp_ps::<_CMP_GT_OQ>(self.0, o.0))
+    }
+
+    #[inline(always)]
+    pub fn ge(self, o: F8) -> M8 {
+        M8(_mm256_cmp_ps::<_CMP_GE_OQ>(self.0, o.0))
+    }
+
+    #[inline(always)]
+    pub fn lt(self, o: F8) -> M8 {
+        M8(_mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0))
+    }
+
+    /// Lane-wise `!=` (true where either lane is NaN, as the scalar `!=`).
+    #[inline(always)]
+    pub fn ne(self, o: F8) -> M8 {
+        M8(_mm256_cmp_ps::<_CMP_NEQ_UQ>(self.0, o.0))
+    }
+
+    /// The lanes whose bits (a word of flags carried as a float's bits) have every bit of
+    /// `bits` set.
+    #[inline(always)]
+    pub fn bits_set(self, bits: u32) -> M8 {
+        let b = _mm256_set1_epi32(bits as i32);
+        M8(_mm256_castsi256_ps(_mm256_cmpeq_epi32(
+            _mm256_and_si256(_mm256_castps_si256(self.0), b),
+            b,
+        )))
+    }
+}
+
+/// Eight 16-byte rows (one per lane: a body's state row, a contact's input row) as four
+/// vectors of eight lanes: lane `l` of output `i` is element `i` of row `l`. Rows `l` and
+/// `l + 4` share a register, and each 128-bit half is transposed as `_MM_TRANSPOSE4_PS`
+/// does (eight shuffles for the eight rows, as for four rows with four lanes).
+#[inline(always)]
+pub(crate) fn rows_to_lanes8(rows: [F4; LANES8]) -> [F8; 4] {
+    let r = |k: usize| -> __m128 { crate::math::wide::sse_register(rows[k]) };
+    let v: [__m256; 4] = core::array::from_fn(|i| _mm256_set_m128(r(i + 4), r(i)));
+    transpose_halves(v).map(F8)
+}
+
+/// The inverse of [`rows_to_lanes8`]: four vectors of eight lanes as eight 16-byte rows.
+#[inline(always)]
+pub(crate) fn lanes_to_rows8(cols: [F8; 4]) -> [F4; LANES8] {
+    let t = transpose_halves(cols.map(|c| c.0));
+    let half = |i: usize| -> F4 {
+        let v = t[i % 4];
+        crate::math::wide::from_sse_register(if i < 4 {
+            _mm256_castps256_ps128(v)
+        } else {
+            _mm256_extractf128_ps::<1>(v)
+        })
+    };
+    core::array::from_fn(half)
+}
+
+/// The 4×4 transpose of each 128-bit half of four registers.
+#[inline(always)]
+fn transpose_halves([v0, v1, v2, v3]: [__m256; 4]) -> [__m256; 4] {
+    let (t0, t1) = (_mm256_unpacklo_ps(v0, v1), _mm256_unpacklo_ps(v2, v3));
+    let (t2, t3) = (_mm256_unpackhi_ps(v0, v1), _mm256_unpackhi_ps(v2, v3));
+    // (0x44: elements 0, 1 of the first and 0, 1 of the second; 0xEE: 2, 3 and 2, 3.)
+    [
+        _mm256_shuffle_ps::<0x44>(t0, t1),
+        _mm256_shuffle_ps::<0xEE>(t0, t1),
+        _mm256_shuffle_ps::<0x44>(t2, t3),
+        _mm256_shuffle_ps::<0xEE>(t2, t3),
+    ]
+}
+
+/// Eight bytes as eight lanes of 32-bit words (zero-extended).
+#[inline(always)]
+fn byte_lanes(b: [u8; LANES8]) -> __m256i {
+    _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(i64::from_le_bytes(b)))
+}
+
+impl M8 {
+    /// Masks from an array.
+    #[inline(always)]
+    pub const fn new(a: [u32; LANES8]) -> M8 {
+        M8(from_m(a))
+    }
+
+    #[inline(always)]
+    pub fn lane(self, i: usize) -> bool {
+        self[i] != 0
+    }
+
+    /// A mask from eight booleans.
+    #[inline(always)]
+    pub fn from_bools(b: [bool; LANES8]) -> M8 {
+        M8::new(b.map(|x| if x { u32::MAX } else { 0 }))
+    }
+
+    /// [`M8::from_bools`] for eight booleans stored side by side in a record (one load and
+    /// a zero extension of each byte into its lane).
+    #[inline(always)]
+    pub fn from_stored_bools(b: [bool; LANES8]) -> M8 {
+        let lanes = byte_lanes(b.map(u8::from));
+        M8(_mm256_castsi256_ps(_mm256_cmpgt_epi32(lanes, _mm256_setzero_si256())))
+    }
+
+    /// The lanes whose byte in `b` is not zero.
+    #[inline(always)]
+    pub fn from_nonzero_bytes(b: [u8; LANES8]) -> M8 {
+        let zero = _mm256_cmpeq_epi32(byte_lanes(b), _mm256_setzero_si256());
+        !M8(_mm256_castsi256_ps(zero))
+    }
+
+    /// The lanes where `a` is zero.
+    #[inline(always)]
+    pub fn zero_lanes(a: [u32; LANES8]) -> M8 {
+        M8(_mm256_castsi256_ps(_mm256_cmpeq_epi32(
+            words(a),
+            _mm256_setzero_si256(),
+        )))
+    }
+
+    /// The lanes where `a` is greater than `k` (unsigned: both offset by 2³¹ for the
+    /// signed compare).
+    #[inline(always)]
+    pub fn above(a: [u32; LANES8], k: u32) -> M8 {
+        let flip = |x: u32| x ^ 0x8000_0000;
+        let v = words(a.map(flip));
+        M8(_mm256_castsi256_ps(_mm256_cmpgt_epi32(
+            v,
+            _mm256_set1_epi32(flip(k) as i32),
+        )))
+    }
+
+    /// The lanes where `a` or `b` is zero.
+    #[inline(always)]
+    pub fn either_zero(a: [u32; LANES8], b: [u32; LANES8]) -> M8 {
+        M8::zero_lanes(a) | M8::zero_lanes(b)
+    }
+
+    /// The eight lanes of a mask as booleans.
+    #[inline(always)]
+    pub fn to_bools(self) -> [bool; LANES8] {
+        let bits = _mm256_movemask_ps(self.0);
+        core::array::from_fn(|i| bits >> i & 1 != 0)
+    }
+
+    /// Whether some lane is true.
+    #[inline(always)]
+    pub fn any(self) -> bool {
+        _mm256_movemask_ps(self.0) != 0
+    }
+
+    /// Whether every lane is true.
+    #[inline(always)]
+    pub fn all(self) -> bool {
+        _mm256_movemask_ps(self.0) == 0xFF
+    }
+
+    /// `self ? a : b` lane by lane.
+    #[inline(always)]
+    pub fn select(self, a: F8, b: F8) -> F8 {
+        F8(_mm256_or_ps(_mm256_and_ps(self.0, a.0), _mm256_andnot_ps(self.0, b.0)))
+    }
+
+    /// 1.0 where true, 0.0 where false.
+    #[inline(always)]
+    pub fn to_unit(self) -> F8 {
+        F8(_mm256_and_ps(self.0, _mm256_set1_ps(1.0)))
+    }
+}
+
+macro_rules! f8_binop {
+    ($tr:ident, $f:ident, $avx:ident) => {
+        impl $tr for F8 {
+            type Output = F8;
+            #[inline(always)]
+            fn $f(self, o: F8) -> F8 {
+                F8($avx(self.0, o.0))
+            }
+        }
+    };
+}
+f8_binop!(Add, add, _mm256_add_ps);
+f8_binop!(Sub, sub, _mm256_sub_ps);
+f8_binop!(Mul, mul, _mm256_mul_ps);
+f8_binop!(Div, div, _mm256_div_ps);
+
+impl Mul<F8> for f32 {
+    type Output = F8;
+    #[inline(always)]
+    fn mul(self, o: F8) -> F8 {
+        F8::splat(self) * o
+    }
+}
+
+impl Neg for F8 {
+    type Output = F8;
+    #[inline(always)]
+    fn neg(self) -> F8 {
+        F8(_mm256_xor_ps(self.0, _mm256_set1_ps(-0.0)))
+    }
+}
+
+impl AddAssign for F8 {
+    #[inline(always)]
+    fn add_assign(&mut self, o: F8) {
+        *self = *self + o;
+    }
+}
+
+impl SubAssign for F8 {
+    #[inline(always)]
+    fn sub_assign(&mut self, o: F8) {
+        *self = *self - o;
+    }
+}
+
+impl BitAnd for M8 {
+    type Output = M8;
+    #[inline(always)]
+    fn bitand(self, o: M8) -> M8 {
+        M8(_mm256_and_ps(self.0, o.0))
+    }
+}
+
+impl BitOr for M8 {
+    type Output = M8;
+    #[inline(always)]
+    fn bitor(self, o: M8) -> M8 {
+        M8(_mm256_or_ps(self.0, o.0))
+    }
+}
+
+impl Not for M8 {
+    type Output = M8;
+    #[inline(always)]
+    fn not(self) -> M8 {
+        M8(_mm256_xor_ps(self.0, _mm256_castsi256_ps(_mm256_set1_epi32(-1))))
+    }
+}
+
+crate::math::wide::lane_vectors!(V8, F8, "Eight 2D vectors, one per lane.");
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn f8(f: impl Fn(usize) -> f32) -> F8 {
+        F8::new(core::array::from_fn(f))
+    }
+
+    /// Every operation gives each lane what the scalar expression gives, NaN and signed
+    /// zeros included (the same rules as the four-lane operations).
+    #[test]
+    fn eight_lanes_match_scalar_arithmetic() {
+        let xs = [1.5, -2.0, 0.0, 3.25, f32::NAN, -0.0, 1e-30, 7.0];
+        let ys = [0.5, 4.0, -0.0, -1.0, 1.0, 0.0, f32::NAN, 7.0];
+        let (a, b) = (F8::new(xs), F8::new(ys));
+        let same = |v: F8, f: &dyn Fn(f32, f32) -> f32| {
+            for l in 0..LANES8 {
+                assert_eq!(v[l].to_bits(), f(xs[l], ys[l]).to_bits(), "lane {l}");
+            }
+        };
+        same(a + b, &|x, y| x + y);
+        same(a - b, &|x, y| x - y);
+        same(a * b, &|x, y| x * y);
+        same(a / b, &|x, y| x / y);
+        same(-a, &|x, _| -x);
+        same(a.abs(), &|x, _| f32::from_bits(x.to_bits() & 0x7fff_ffff));
+        same(a.sqrt(), &|x, _| x.sqrt());
+        same(a.max(b), &|x, y| if x > y { x } else { y });
+        same(a.min(b), &|x, y| if x < y { x } else { y });
+        let mask = |m: M8, f: &dyn Fn(f32, f32) -> bool| {
+            assert_eq!(m.to_bools(), core::array::from_fn(|l| f(xs[l], ys[l])));
+        };
+        mask(a.gt(b), &|x, y| x > y);
+        mask(a.ge(b), &|x, y| x >= y);
+        mask(a.lt(b), &|x, y| x < y);
+        mask(a.ne(b), &|x, y| x != y);
+        let m = a.gt(b);
+        same(m.select(a, b), &|x, y| if x > y { x } else { y });
+        same(m.to_unit(), &|x, y| if x > y { 1.0 } else { 0.0 });
+        assert!(m.any() && !m.all() && (m | !m).all() && !(m & !m).any());
+    }
+
+    /// Masks from stored booleans, bytes and words set exactly their own lanes.
+    #[test]
+    fn eight_lane_masks_set_exactly_their_lanes() {
+        for l in 0..LANES8 {
+            for x in [1u8, 2, 0x80, 0xFF] {
+                let mut bytes = [0u8; LANES8];
+                bytes[l] = x;
+                let one: [bool; LANES8] = core::array::from_fn(|k| k == l);
+                assert_eq!(M8::from_nonzero_bytes(bytes).to_bools(), one);
+                assert_eq!(M8::from_stored_bools(one).to_bools(), one);
+                assert_eq!(M8::from_bools(one).to_bools(), one);
+                let mut words = [5u32; LANES8];
+                words[l] = 0;
+                assert_eq!(M8::zero_lanes(words).to_bools(), one);
+                let mut big = [1u32; LANES8];
+                big[l] = 0x8000_0001;
+                assert_eq!(M8::above(big, 0x8000_0000).to_bools(), one);
+            }
+        }
+        let words = f8(|l| f32::from_bits([0xffff_ffff, 0x8000_0002, 0x7fc0_0001, 1, 3, 0, 2, 7][l]));
+        assert_eq!(
+            words.bits_set(3).to_bools(),
+            [true, false, false, false, true, false, false, true]
+        );
+    }
+
+    /// Rows to lanes and back: lane `l` of vector `i` is element `i` of row `l`.
+    #[test]
+    fn rows_and_lanes_are_transposes() {
+        let rows: [F4; LANES8] = core::array::from_fn(|l| F4::new(core::array::from_fn(|i| (10 * l + i) as f32)));
+        let cols = rows_to_lanes8(rows);
+        for (i, c) in cols.iter().enumerate() {
+            assert_eq!(**c, core::array::from_fn(|l| (10 * l + i) as f32));
+        }
+        assert_eq!(lanes_to_rows8(cols), rows);
+    }
+}
