@@ -9,11 +9,25 @@
 # It builds into its own target directory: the CFLAGS change Box2D's build, and a separate
 # directory keeps that build apart from the workspace's (and from the tests' smoke build).
 #
-# Usage: crates/tribo-bench/run.sh [SCENE|all] [--runs R] [--steps N] [--threads T] [--json FILE] [--profile]
+# Usage: [AVX2=1 | BOX2D_AVX2=1] crates/tribo-bench/run.sh [SCENE|all] [--runs R] [--steps N] [--threads T] [--json FILE] [--profile]
 #        crates/tribo-bench/run.sh scaling [--sizes 1000,4000,16000,64000] [--runs R] [--large-runs R64] [--steps N] [--json FILE]
 # (SCENE: large_pyramid, many_pyramids, smash, tumbler, scaling_rain_<n>; every argument is passed to the program.)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 export CFLAGS="${CFLAGS:--O3 -DNDEBUG}"
+# AVX2=1 builds both engines for AVX2 (eight lanes a wide contact in each): Tribo with
+# RUSTFLAGS="-C target-feature=+avx2" (tribo::SOLVER_LANES = 8) and Box2D with its
+# BOX2D_AVX2 path (boxdd's simd-avx2, the `box2d-avx2` feature), in a target directory of
+# their own. BOX2D_AVX2=1 builds only Box2D so. Both are off by default, as in Box2D's CMake
+# build; the binaries then need a CPU with AVX2.
+features=()
+if [[ "${AVX2:-0}" == 1 ]]; then
+    export RUSTFLAGS="${RUSTFLAGS:-} -C target-feature=+avx2"
+    features=(--features box2d-avx2)
+    export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$here/../../target/bench-avx2-both}"
+elif [[ "${BOX2D_AVX2:-0}" == 1 ]]; then
+    features=(--features box2d-avx2)
+    export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$here/../../target/bench-avx2}"
+fi
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$here/../../target/bench}"
-exec cargo run --release -p tribo-bench --manifest-path "$here/../../Cargo.toml" -- "$@"
+exec cargo run --release -p tribo-bench "${features[@]}" --manifest-path "$here/../../Cargo.toml" -- "$@"

@@ -39,6 +39,18 @@ impl EngineKind {
             EngineKind::Rapier => "rapier",
         }
     }
+
+    /// How the engine's contact solver was built for this run (the JSON's `simd`).
+    pub fn simd(self) -> &'static str {
+        match self {
+            EngineKind::Tribo | EngineKind::TriboMus15 if tribo::SOLVER_LANES == 8 => "avx2-8",
+            EngineKind::Tribo | EngineKind::TriboMus15 => "sse2-4",
+            EngineKind::Box2d if cfg!(feature = "box2d-avx2") => "avx2-8",
+            EngineKind::Box2d => "sse2-4",
+            // rapier2d's default features (no `simd8`), for the x86-64 baseline.
+            EngineKind::Rapier => "default",
+        }
+    }
 }
 
 /// A built world that the harness can step and read.

@@ -221,6 +221,9 @@ fn run(args: &Args) -> Result<(), BoxError> {
                     "contacts": r.contacts,
                     "bodies": scene.bodies.len(),
                     "dynamic_bodies": dynamic,
+                    // How the engine's wide solver was built (Box2D's AVX2 path is a build
+                    // option, `box2d-avx2`).
+                    "simd": r.kind.simd(),
                 });
                 writeln!(out, "{line}")?;
             }
@@ -275,9 +278,23 @@ fn print_header(args: &Args) {
         .map(|v| format!("{}.{}.{}", v.major, v.minor, v.revision));
     println!("tribo-bench: CPU {cpu}, {cores} cores available");
     println!(
-        "Box2D {} via boxdd 0.6 (C flags from CFLAGS: \"{}\"), Rapier 0.36 ({}), Rust profile {}",
+        "Tribo's wide solver: {} lanes ({})",
+        tribo::SOLVER_LANES,
+        if tribo::SOLVER_LANES == 8 {
+            "built for AVX2"
+        } else {
+            "SSE2, the x86-64 baseline"
+        }
+    );
+    println!(
+        "Box2D {} via boxdd 0.6 (C flags from CFLAGS: \"{}\"; SIMD: {}), Rapier 0.36 ({}), Rust profile {}",
         b2.unwrap_or_else(|_| "?".into()),
         env!("TRIBO_BENCH_CFLAGS"),
+        if cfg!(feature = "box2d-avx2") {
+            "AVX2, 8 lanes, boxdd's simd-avx2"
+        } else {
+            "SSE2, 4 lanes, Box2D's default"
+        },
         if cfg!(feature = "rapier-parallel") {
             "parallel feature on"
         } else {
