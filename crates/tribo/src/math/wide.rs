@@ -78,22 +78,23 @@ pub(crate) struct M4(RawM);
 
 const _: () = assert!(core::mem::size_of::<F4>() == 16 && core::mem::size_of::<M4>() == 16);
 
-/// The lanes of `$t` as an array of `$e` through `Deref` (`as_lanes::$view`), and the
-/// comparison and debug print that read them.
+/// The `$n` lanes of `$t` as an array of `$e` through `Deref` (`$view`, `$view_mut`: the
+/// register's bytes seen as the array), the comparison and debug print that read them, and
+/// `Eq` and `Default` (all lanes zero) for the mask type `$m` (also used by `wide8`).
 macro_rules! lane_array {
-    ($t:ident, $e:ty, $view:ident, $view_mut:ident) => {
+    ($t:ident, $e:ty, $n:expr, $view:path, $view_mut:path) => {
         impl core::ops::Deref for $t {
-            type Target = [$e; LANES4];
+            type Target = [$e; $n];
             #[inline(always)]
-            fn deref(&self) -> &[$e; LANES4] {
-                as_lanes::$view(&self.0)
+            fn deref(&self) -> &[$e; $n] {
+                $view(&self.0)
             }
         }
 
         impl core::ops::DerefMut for $t {
             #[inline(always)]
-            fn deref_mut(&mut self) -> &mut [$e; LANES4] {
-                as_lanes::$view_mut(&mut self.0)
+            fn deref_mut(&mut self) -> &mut [$e; $n] {
+                $view_mut(&mut self.0)
             }
         }
 
@@ -108,24 +109,20 @@ macro_rules! lane_array {
                 write!(f, concat!(stringify!($t), "({:?})"), **self)
             }
         }
+
+        impl Default for $t {
+            fn default() -> $t {
+                $t::new([Default::default(); $n])
+            }
+        }
     };
 }
-lane_array!(F4, f32, f, f_mut);
-lane_array!(M4, u32, m, m_mut);
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+pub(crate) use lane_array;
+lane_array!(F4, f32, LANES4, as_lanes::f, as_lanes::f_mut);
+lane_array!(M4, u32, LANES4, as_lanes::m, as_lanes::m_mut);
 
 impl Eq for M4 {}
-
-impl Default for F4 {
-    fn default() -> F4 {
-        F4::ZERO
-    }
-}
-
-impl Default for M4 {
-    fn default() -> M4 {
-        M4::new([0; LANES4])
-    }
-}
 
 /// The lanes of a register as an array, in place.
 #[cfg(target_arch = "x86_64")]

@@ -126,52 +126,10 @@ mod avx {
 
 use avx::*;
 
-macro_rules! lane_array8 {
-    ($t:ident, $e:ty, $view:ident, $view_mut:ident) => {
-        impl core::ops::Deref for $t {
-            type Target = [$e; LANES8];
-            #[inline(always)]
-            fn deref(&self) -> &[$e; LANES8] {
-                avx::$view(&self.0)
-            }
-        }
-
-        impl core::ops::DerefMut for $t {
-            #[inline(always)]
-            fn deref_mut(&mut self) -> &mut [$e; LANES8] {
-                avx::$view_mut(&mut self.0)
-            }
-        }
-
-        impl PartialEq for $t {
-            fn eq(&self, o: &$t) -> bool {
-                **self == **o
-            }
-        }
-
-        impl core::fmt::Debug for $t {
-            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-                write!(f, concat!(stringify!($t), "({:?})"), **self)
-            }
-        }
-    };
-}
-lane_array8!(F8, f32, f, f_mut);
-lane_array8!(M8, u32, m, m_mut);
+crate::math::wide::lane_array!(F8, f32, LANES8, avx::f, avx::f_mut);
+crate::math::wide::lane_array!(M8, u32, LANES8, avx::m, avx::m_mut);
 
 impl Eq for M8 {}
-
-impl Default for F8 {
-    fn default() -> F8 {
-        F8::ZERO
-    }
-}
-
-impl Default for M8 {
-    fn default() -> M8 {
-        M8::new([0; LANES8])
-    }
-}
 
 impl F8 {
     pub const ZERO: F8 = F8::new([0.0; LANES8]);
