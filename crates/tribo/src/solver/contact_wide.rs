@@ -1,4 +1,6 @@
-//! The wide contact solver: graph colouring and four contacts per SIMD lane group.
+//! The wide contact solver: graph colouring and four contacts per SIMD lane group (eight
+//! in a build for AVX2: [`LANES`]; "four" below reads as `LANES`, and the byte counts as
+//! those of four lanes).
 //!
 //! The physics is exactly the scalar contact constraint's ([`super::contact_solver`]: soft
 //! normal rows with preload, 2×2 block solve, patch friction with stick/slip and the drift
