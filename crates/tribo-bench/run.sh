@@ -22,6 +22,9 @@ export CFLAGS="${CFLAGS:--O3 -DNDEBUG}"
 # build; the binaries then need a CPU with AVX2.
 features=()
 if [[ "${AVX2:-0}" == 1 ]]; then
+    # (The whole build: Rapier is compiled for AVX2 too; CARGO_ENCODED_RUSTFLAGS would
+    # override RUSTFLAGS.)
+    unset CARGO_ENCODED_RUSTFLAGS
     export RUSTFLAGS="${RUSTFLAGS:-} -C target-feature=+avx2"
     features=(--features box2d-avx2)
     export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$here/../../target/bench-avx2-both}"
@@ -30,4 +33,4 @@ elif [[ "${BOX2D_AVX2:-0}" == 1 ]]; then
     export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$here/../../target/bench-avx2}"
 fi
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$here/../../target/bench}"
-exec cargo run --release -p tribo-bench "${features[@]}" --manifest-path "$here/../../Cargo.toml" -- "$@"
+exec cargo run --release -p tribo-bench ${features[@]+"${features[@]}"} --manifest-path "$here/../../Cargo.toml" -- "$@"

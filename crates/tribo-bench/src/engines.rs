@@ -47,7 +47,9 @@ impl EngineKind {
             EngineKind::Tribo | EngineKind::TriboMus15 => "sse2-4",
             EngineKind::Box2d if cfg!(feature = "box2d-avx2") => "avx2-8",
             EngineKind::Box2d => "sse2-4",
-            // rapier2d's default features (no `simd8`), for the x86-64 baseline.
+            // rapier2d's default features (no `simd8`); compiled for AVX2 when the whole
+            // build is (`AVX2=1 run.sh`).
+            EngineKind::Rapier if cfg!(target_feature = "avx2") => "default-avx2",
             EngineKind::Rapier => "default",
         }
     }

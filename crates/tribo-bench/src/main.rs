@@ -287,7 +287,7 @@ fn print_header(args: &Args) {
         }
     );
     println!(
-        "Box2D {} via boxdd 0.6 (C flags from CFLAGS: \"{}\"; SIMD: {}), Rapier 0.36 ({}), Rust profile {}",
+        "Box2D {} via boxdd 0.6 (C flags from CFLAGS: \"{}\"; SIMD: {}), Rapier 0.36 ({}{}), Rust profile {}",
         b2.unwrap_or_else(|_| "?".into()),
         env!("TRIBO_BENCH_CFLAGS"),
         if cfg!(feature = "box2d-avx2") {
@@ -299,6 +299,11 @@ fn print_header(args: &Args) {
             "parallel feature on"
         } else {
             "serial build"
+        },
+        if cfg!(target_feature = "avx2") {
+            ", compiled for AVX2"
+        } else {
+            ""
         },
         env!("TRIBO_BENCH_PROFILE"),
     );

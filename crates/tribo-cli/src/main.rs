@@ -16,7 +16,7 @@ use tribo_scenes::scenes;
 #[derive(Parser)]
 #[command(
     name = "tribo",
-    version,
+    version = tribo::BUILD,
     about = "Tribo: 2D rigid bodies with static and dynamic friction"
 )]
 struct Cli {

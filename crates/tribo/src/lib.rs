@@ -68,6 +68,19 @@ pub use world::{
 /// Contact constraints the wide solver handles at once in this build: 4 (SSE2, the x86-64
 /// baseline and any other target) or 8 when the crate is compiled for AVX2 (`RUSTFLAGS="-C
 /// target-feature=+avx2"`, the counterpart of Box2D's `BOX2D_AVX2` option). Results do not
-/// depend on it: every lane computes the same expressions, so both builds step a scene to
-/// the same bits (`.ci/run` compares their trajectories).
+/// depend on it: every lane computes the same expressions, and where a group takes one
+/// branch for all its lanes (the one-point form of the normal rows, the rolling row) the
+/// other branch adds only exact zeros, which can at most turn a velocity of −0.0 into +0.0
+/// (and the velocity integration makes every −0.0 +0.0 anyway, unless an acceleration is
+/// −0.0). Both builds step a scene to the same bits (`.ci/run` compares their trajectories).
 pub const SOLVER_LANES: usize = math::wide::LANES;
+
+/// The crate version and how its wide solver was built, e.g. `0.1.0 (solver: 4 lanes,
+/// SSE2)` (what `tribo --version` prints).
+#[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+pub const BUILD: &str = concat!(env!("CARGO_PKG_VERSION"), " (solver: 4 lanes, SSE2)");
+/// The crate version and how its wide solver was built, e.g. `0.1.0 (solver: 8 lanes,
+/// AVX2)` (what `tribo --version` prints).
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+pub const BUILD: &str = concat!(env!("CARGO_PKG_VERSION"), " (solver: 8 lanes, AVX2)");
+const _: () = assert!(SOLVER_LANES == 4 || SOLVER_LANES == 8);

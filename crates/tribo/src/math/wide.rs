@@ -1,5 +1,6 @@
-//! Four-lane floats: the wide contact solver's lanes, and the few four-wide steps of
-//! manifold recycling and polygon collision.
+//! Four-lane floats: the wide contact solver's lanes in the default build (eight-lane ones
+//! in a build for AVX2: `wide8`, through [`FL`]), and the few four-wide steps of manifold
+//! recycling and polygon collision.
 //!
 //! `F4` is four `f32` lanes; every operation is lane-wise plain IEEE arithmetic (no fused
 //! multiply-add, no approximate reciprocal), so a lane computes bit for bit what the same
@@ -20,8 +21,10 @@ pub(crate) const LANES4: usize = 4;
 
 /// The wide contact solver's lane vectors: [`F4`], [`M4`] and [`V4`] (SSE, four lanes),
 /// or in a build for AVX2 (`-C target-feature=+avx2`, as Box2D's `BOX2D_AVX2`) the
-/// eight-lane [`super::wide8::F8`], `M8` and `V8`. A lane computes the same expressions
-/// either way; only how many constraints a group holds changes.
+/// eight-lane `wide8::F8`, `M8` and `V8`. A lane computes the same expressions either way;
+/// only how many constraints a group holds changes (and so, for a group-wide branch, which
+/// branch a lane takes: they agree to the bit but for the sign of a zero velocity, see
+/// `crate::SOLVER_LANES`).
 #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
 pub(crate) use self::{F4 as FL, M4 as ML, V4 as VL};
 #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
@@ -337,7 +340,7 @@ impl F4 {
         simd!(sse::to_f(_mm_set1_ps(x)), F4::new([x; LANES4]))
     }
 
-    /// Lane-wise maximum (`a > b ? a : b`, like SSE `maxps` with the operands swapped).
+    /// Lane-wise maximum (`a > b ? a : b`, SSE `maxps`).
     #[inline(always)]
     pub fn max(self, o: F4) -> F4 {
         simd!(

@@ -145,7 +145,7 @@ impl F8 {
         F8(_mm256_set1_ps(x))
     }
 
-    /// Lane-wise maximum (`a > b ? a : b`, as `F4::max`).
+    /// Lane-wise maximum (`a > b ? a : b`, SSE's and AVX's `maxps`, as `F4::max`).
     #[inline(always)]
     pub fn max(self, o: F8) -> F8 {
         F8(_mm256_max_ps(self.0, o.0))

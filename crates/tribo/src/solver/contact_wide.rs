@@ -243,8 +243,8 @@ fn gather<S: StateRead>(states: &[S], idx: &[u32; LANES]) -> WideBody {
 fn scatter<S: StateCell>(states: &[S], idx: &[u32; LANES], write: &[bool; LANES], b: &WideBody) {
     let rows = lanes_to_rows([b.v.x, b.v.y, b.w, b.touched]);
     // Every lane's body is dynamic in most groups (all but those against the ground or a
-    // kinematic body): one test of the four flags as a word, not a branch per lane (a
-    // single loop testing `all || write[l]` was not split by the compiler: +2 % solve
+    // kinematic body): one test of all the flags (one word compare), not a branch per lane
+    // (a single loop testing `all || write[l]` was not split by the compiler: +2 % solve
     // instructions).
     if *write == [true; LANES] {
         for l in 0..LANES {
@@ -723,7 +723,7 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
 /// rolling resistance in the relax pass. Inlined into the colour loops: called once per
 /// group, it re-broadcast the loop's invariants (context, softness, elapsed time) and
 /// spilled them every group (solve 0.69 → 0.66 ms, relax 0.64 → 0.61 in large_pyramid;
-/// the warm start is better left a call).
+/// the warm start is better left a call with four lanes, and inlined with eight).
 ///
 /// Each row works in moment form ([`RowFrame`], [`row_speed`], [`apply_row`]): a point
 /// keeps the two moments of its lever arms about the row direction, not the arms' four
@@ -871,7 +871,7 @@ pub(crate) fn build_group<S: StateRead>(
     };
     let count_of = |input: &ContactInput| input.count.min(2);
     // Fields that lie side by side in a candidate come as one 16-byte row per lane,
-    // transposed into four lanes of each (zeros in an empty lane): eight shuffles instead
+    // transposed into four lanes of each (zeros in an empty lane): eight shuffles (with four lanes) instead
     // of sixteen single-lane loads and inserts per row.
     let columns = |row: &dyn Fn(&ContactInput, &ConstraintBodies) -> [f32; 4]| {
         rows_to_lanes(core::array::from_fn(|l| F4::new(row(read[l].0, read[l].1))))
@@ -2000,6 +2000,66 @@ mod tests {
             h.two_points.lane(0) && w.block.lane(0),
             "lane 0 is a face the block solves"
         );
+    }
+
+    /// A lane gets the same bits whatever the other lanes of its group: the group-wide
+    /// branches (the normal rows' one-point form, the rolling row) give a lane that does
+    /// not need them only exact zeros, so a one-point constraint solved alone and solved
+    /// beside a two-point face with rolling resistance ends with the same impulses and the
+    /// same body states, to the bit (with nonzero velocities: a zero added to −0.0 gives
+    /// +0.0). This is why the four- and eight-lane builds step alike
+    /// (`crate::SOLVER_LANES`): their groups hold different neighbours.
+    #[test]
+    fn a_lane_gets_the_same_bits_whatever_its_neighbours() {
+        let ctx = StepContext::for_tests();
+        let soft = StepSoftness::new(&ctx);
+        let states = vec![
+            BodyState::default(),
+            moved_state(0.4, -0.5, 1.5, Vec2::new(1e-3, -2e-3), 0.01),
+            moved_state(-0.3, 0.2, -0.7, Vec2::new(-1e-3, 1e-3), -0.02),
+            moved_state(0.7, -0.1, 0.3, Vec2::ZERO, 0.0),
+            moved_state(-0.2, 0.6, -1.1, Vec2::ZERO, 0.0),
+        ];
+        // (No rolling impulse carried over: without rolling resistance the relax leaves none.)
+        let single = (
+            5u32,
+            ContactInput {
+                rolling_impulse: 0.0,
+                ..input(1, false, 0.0, 0.0)
+            },
+            bodies(1, 2),
+        );
+        let face = (6u32, input(2, false, 0.0, 0.05), bodies(3, 4));
+        // Warm start, biased and relax passes; then lane 0's impulses and its two bodies.
+        let run = |cases: &[(u32, ContactInput, ConstraintBodies)]| {
+            let (mut h, mut w, _, dv) = built(lanes_of(cases), Vec2::new(0.0, 1.0), &ctx, &states);
+            let (two, rolling) = (h.two_points.any(), h.any_rolling);
+            let cells: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
+            warm_start(&mut h, &cells);
+            solve::<true, _>(&mut h, &mut w, &dv, &cells, &ctx, &soft, ctx.h);
+            solve::<false, _>(&mut h, &mut w, &dv, &cells, &ctx, &soft, ctx.h);
+            // Through `Debug`, which tells −0.0 from +0.0.
+            let lane = format!(
+                "{:?}",
+                (
+                    h.points.map(|p| p.normal_impulse[0]),
+                    h.tangent_impulse[0],
+                    h.rolling_impulse[0],
+                    w.points.map(|p| p.total_normal_impulse[0]),
+                    w.total_tangent_impulse[0],
+                )
+            );
+            (lane, format!("{:?}", [cells[1].get(), cells[2].get()]), two, rolling)
+        };
+        let alone = run(&[single]);
+        let beside = run(&[single, face]);
+        assert!(!alone.2 && !alone.3, "alone: the one-point form, no rolling row");
+        assert!(
+            beside.2 && beside.3,
+            "beside the face: the two-point form and the rolling row"
+        );
+        assert_eq!(alone.0, beside.0, "the lane's impulses");
+        assert_eq!(alone.1, beside.1, "its bodies' states");
     }
 
     /// The store's wide half must write into each contact exactly what the scalar store

@@ -51,10 +51,11 @@ pub(crate) struct BodyState {
 }
 
 /// A body's [`BodyState`] shared by the worker threads of a step: plain memory, read and
-/// written without atomics (one of the crate's six `unsafe` sites; the others are
+/// written without atomics (one of the crate's seven `unsafe` sites; the others are
 /// [`SharedState::from_mut_slice`], [`prefetch`], the SSE intrinsics of [`wide`], the lanes
-/// of a [`wide`] register read as an array (its `Deref`) and the row access of [`rows_at`]
-/// and [`write_velocity_row`]).
+/// of a [`wide`] register read as an array (its `Deref`), the row access of [`rows_at`]
+/// and [`write_velocity_row`], and in a build for AVX2 `math::wide8`'s intrinsics and
+/// lanes).
 ///
 /// Why it is race-free — the contract every user of [`StateCell`] for `SharedState` keeps:
 /// - a constraint pass runs colour by colour, and the constraints of one colour share no
