@@ -83,7 +83,7 @@ const _: () = assert!(core::mem::size_of::<F4>() == 16 && core::mem::size_of::<M
 
 /// The `$n` lanes of `$t` as an array of `$e` through `Deref` (`$view`, `$view_mut`: the
 /// register's bytes seen as the array), the comparison and debug print that read them, and
-/// `Eq` and `Default` (all lanes zero) for the mask type `$m` (also used by `wide8`).
+/// `Default` (all lanes zero). Also used by `wide8`.
 macro_rules! lane_array {
     ($t:ident, $e:ty, $n:expr, $view:path, $view_mut:path) => {
         impl core::ops::Deref for $t {

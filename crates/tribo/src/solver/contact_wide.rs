@@ -871,8 +871,8 @@ pub(crate) fn build_group<S: StateRead>(
     };
     let count_of = |input: &ContactInput| input.count.min(2);
     // Fields that lie side by side in a candidate come as one 16-byte row per lane,
-    // transposed into four lanes of each (zeros in an empty lane): eight shuffles (with four lanes) instead
-    // of sixteen single-lane loads and inserts per row.
+    // transposed into lanes of each (zeros in an empty lane): with four lanes eight
+    // shuffles instead of sixteen single-lane loads and inserts per row.
     let columns = |row: &dyn Fn(&ContactInput, &ConstraintBodies) -> [f32; 4]| {
         rows_to_lanes(core::array::from_fn(|l| F4::new(row(read[l].0, read[l].1))))
     };
