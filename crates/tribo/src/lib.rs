@@ -77,8 +77,12 @@ pub const SOLVER_LANES: usize = math::wide::LANES;
 
 /// The crate version and how its wide solver was built, e.g. `0.1.0 (solver: 4 lanes,
 /// SSE2)` (what `tribo --version` prints).
-#[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+#[cfg(all(target_arch = "x86_64", not(target_feature = "avx2")))]
 pub const BUILD: &str = concat!(env!("CARGO_PKG_VERSION"), " (solver: 4 lanes, SSE2)");
+/// The crate version and how its wide solver was built: `0.1.0 (solver: 4 lanes)` (what
+/// `tribo --version` prints; off x86-64 the lanes are arrays).
+#[cfg(not(target_arch = "x86_64"))]
+pub const BUILD: &str = concat!(env!("CARGO_PKG_VERSION"), " (solver: 4 lanes)");
 /// The crate version and how its wide solver was built, e.g. `0.1.0 (solver: 8 lanes,
 /// AVX2)` (what `tribo --version` prints).
 #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
