@@ -277,15 +277,7 @@ fn print_header(args: &Args) {
         .and_then(|_| boxdd::version())
         .map(|v| format!("{}.{}.{}", v.major, v.minor, v.revision));
     println!("tribo-bench: CPU {cpu}, {cores} cores available");
-    println!(
-        "Tribo's wide solver: {} lanes ({})",
-        tribo::SOLVER_LANES,
-        if tribo::SOLVER_LANES == 8 {
-            "built for AVX2"
-        } else {
-            "SSE2, the x86-64 baseline"
-        }
-    );
+    println!("Tribo {}", tribo::BUILD);
     println!(
         "Box2D {} via boxdd 0.6 (C flags from CFLAGS: \"{}\"; SIMD: {}), Rapier 0.36 ({}{}), Rust profile {}",
         b2.unwrap_or_else(|_| "?".into()),
