@@ -43,7 +43,11 @@ impl EngineKind {
     /// How the engine's contact solver was built for this run (the JSON's `simd`).
     pub fn simd(self) -> &'static str {
         match self {
-            EngineKind::Tribo | EngineKind::TriboMus15 if tribo::SOLVER_LANES == 8 => "avx2-8",
+            EngineKind::Tribo | EngineKind::TriboMus15
+                if tribo_lanes() == tribo::SolverLanes::Auto && tribo::solver_lanes() == 8 =>
+            {
+                "avx2-8"
+            }
             EngineKind::Tribo | EngineKind::TriboMus15 => "sse2-4",
             EngineKind::Box2d if cfg!(feature = "box2d-avx2") => "avx2-8",
             EngineKind::Box2d => "sse2-4",
@@ -52,6 +56,15 @@ impl EngineKind {
             EngineKind::Rapier if cfg!(target_feature = "avx2") => "default-avx2",
             EngineKind::Rapier => "default",
         }
+    }
+}
+
+/// The wide solver Tribo's worlds run: [`tribo::SolverLanes::Auto`] (eight lanes on a CPU
+/// with AVX2), or four with `TRIBO_BENCH_LANES=4` (to time the SSE2 solver on such a CPU).
+pub fn tribo_lanes() -> tribo::SolverLanes {
+    match std::env::var("TRIBO_BENCH_LANES").as_deref() {
+        Ok("4") => tribo::SolverLanes::Four,
+        _ => tribo::SolverLanes::Auto,
     }
 }
 
@@ -200,6 +213,7 @@ mod tribo_sim {
             }
             let def = tribo::WorldDef {
                 workers: threads as u32,
+                solver_lanes: tribo_lanes(),
                 ..*built.world.def()
             };
             built.world.set_def(def)?;

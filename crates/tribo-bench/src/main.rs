@@ -277,7 +277,13 @@ fn print_header(args: &Args) {
         .and_then(|_| boxdd::version())
         .map(|v| format!("{}.{}.{}", v.major, v.minor, v.revision));
     println!("tribo-bench: CPU {cpu}, {cores} cores available");
-    println!("Tribo {}", tribo::BUILD);
+    match engines::tribo_lanes() {
+        tribo::SolverLanes::Four => println!(
+            "Tribo {} (solver: 4 lanes, TRIBO_BENCH_LANES=4)",
+            env!("CARGO_PKG_VERSION")
+        ),
+        _ => println!("Tribo {}", tribo::build_info()),
+    }
     println!(
         "Box2D {} via boxdd 0.6 (C flags from CFLAGS: \"{}\"; SIMD: {}), Rapier 0.36 ({}{}), Rust profile {}",
         b2.unwrap_or_else(|_| "?".into()),

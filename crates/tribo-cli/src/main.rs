@@ -13,15 +13,28 @@ use std::time::Instant;
 use tribo_scenes::format::{self, SceneFile};
 use tribo_scenes::scenes;
 
+/// The crate version and the wide solver this CPU runs (`tribo::build_info`).
+static VERSION: std::sync::LazyLock<String> = std::sync::LazyLock::new(tribo::build_info);
+
 #[derive(Parser)]
 #[command(
     name = "tribo",
-    version = tribo::BUILD,
+    version = VERSION.as_str(),
     about = "Tribo: 2D rigid bodies with static and dynamic friction"
 )]
 struct Cli {
     #[command(subcommand)]
     command: Command,
+}
+
+/// `--solver-lanes` (`tribo::SolverLanes`).
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum Lanes {
+    /// Eight lanes (AVX2) if the CPU has AVX2, else four.
+    Auto,
+    /// Four lanes (SSE2 on x86-64).
+    #[value(name = "4")]
+    Four,
 }
 
 #[derive(Subcommand)]
@@ -62,6 +75,10 @@ pub struct RunArgs {
     /// Worker threads for each step (1..=256; results are identical for every count).
     #[arg(long, default_value_t = 1)]
     pub threads: u32,
+    /// Contact constraints the solver handles at once: `auto` (8 with AVX2, else 4) or `4`
+    /// (results are identical either way; `tribo --version` shows what `auto` takes).
+    #[arg(long, value_enum, default_value_t = Lanes::Auto)]
+    pub solver_lanes: Lanes,
     /// Trajectory output: .csv or .jsonl.
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -181,6 +198,10 @@ fn run(args: &RunArgs) -> Result<(), String> {
     let mut built = scene.build().map_err(|e| e.to_string())?;
     let def = tribo::WorldDef {
         workers: args.threads,
+        solver_lanes: match args.solver_lanes {
+            Lanes::Auto => tribo::SolverLanes::Auto,
+            Lanes::Four => tribo::SolverLanes::Four,
+        },
         ..*built.world.def()
     };
     built.world.set_def(def).map_err(|e| format!("--threads: {e}"))?;

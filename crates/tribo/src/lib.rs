@@ -62,29 +62,35 @@ pub use geometry::{Capsule, ChainSegment, Circle, GeometryError, MassData, Polyg
 pub use math::{Aabb, Rot, Transform, Vec2};
 pub use world::{
     BodyId, ContactBeginEvent, ContactEndEvent, ContactEvents, ContactInfo, ContactPointInfo, JointId, Profile,
-    QueryFilter, RayResult, ShapeId, World, WorldDef,
+    QueryFilter, RayResult, ShapeId, SolverLanes, World, WorldDef,
 };
 
-/// Contact constraints the wide solver handles at once in this build: 4 (SSE2, the x86-64
-/// baseline and any other target) or 8 when the crate is compiled for AVX2 (`RUSTFLAGS="-C
-/// target-feature=+avx2"`, the counterpart of Box2D's `BOX2D_AVX2` option). Results do not
-/// depend on it: every lane computes the same expressions, and where a group takes one
-/// branch for all its lanes (the one-point form of the normal rows, the rolling row) the
-/// other branch adds only exact zeros, which can at most turn a velocity of −0.0 into +0.0
-/// (and the velocity integration makes every −0.0 +0.0 anyway, unless an acceleration is
-/// −0.0). Both builds step a scene to the same bits (`.ci/run` compares their trajectories).
-pub const SOLVER_LANES: usize = math::wide::LANES;
+/// Contact constraints the wide solver handles at once in a world made with the default
+/// [`SolverLanes::Auto`] on this CPU: 8 on an x86-64 CPU that has AVX2 (the solver is
+/// compiled a second time for AVX2 into every x86-64 build and chosen at run time, so a
+/// binary for the x86-64 baseline still runs eight lanes there; Box2D's counterpart,
+/// `BOX2D_AVX2`, is a compile-time option), else 4 (SSE2, the x86-64 baseline, or arrays
+/// on other targets).
+///
+/// Results do not depend on it: every lane computes the same expressions, and where a
+/// group takes one branch for all its lanes (the one-point form of the normal rows, the
+/// rolling row) the other branch adds only exact zeros, which can at most turn a velocity
+/// of −0.0 into +0.0 (and the velocity integration makes every −0.0 +0.0 anyway, unless an
+/// acceleration is −0.0). Worlds with four and eight lanes step a scene to the same bits
+/// (a test steps every library scene both ways; `.ci/run` compares CLI trajectories).
+pub fn solver_lanes() -> usize {
+    solver::Contacts::new(SolverLanes::Auto).lanes()
+}
 
-/// The crate version and how its wide solver was built, e.g. `0.1.0 (solver: 4 lanes,
-/// SSE2)` (what `tribo --version` prints).
-#[cfg(all(target_arch = "x86_64", not(target_feature = "avx2")))]
-pub const BUILD: &str = concat!(env!("CARGO_PKG_VERSION"), " (solver: 4 lanes, SSE2)");
-/// The crate version and how its wide solver was built: `0.1.0 (solver: 4 lanes)` (what
-/// `tribo --version` prints; off x86-64 the lanes are arrays).
-#[cfg(not(target_arch = "x86_64"))]
-pub const BUILD: &str = concat!(env!("CARGO_PKG_VERSION"), " (solver: 4 lanes)");
-/// The crate version and how its wide solver was built, e.g. `0.1.0 (solver: 8 lanes,
-/// AVX2)` (what `tribo --version` prints).
-#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
-pub const BUILD: &str = concat!(env!("CARGO_PKG_VERSION"), " (solver: 8 lanes, AVX2)");
-const _: () = assert!(SOLVER_LANES == 4 || SOLVER_LANES == 8);
+/// The crate version and the wide solver [`solver_lanes`] picks on this CPU, e.g. `0.1.0
+/// (solver: 8 lanes, AVX2)` or `0.1.0 (solver: 4 lanes, SSE2)` (what `tribo --version`
+/// prints).
+pub fn build_info() -> String {
+    let lanes = solver_lanes();
+    let simd = match (cfg!(target_arch = "x86_64"), lanes) {
+        (true, 8) => ", AVX2",
+        (true, _) => ", SSE2",
+        (false, _) => "",
+    };
+    format!("{} (solver: {lanes} lanes{simd})", env!("CARGO_PKG_VERSION"))
+}

@@ -6,11 +6,8 @@
 //! All arithmetic is plain `f32` with no fused multiply-add, so a given build produces
 //! bit-identical results run after run.
 
-// In a build for AVX2 the solver takes its lanes from `wide8`, and some four-lane
-// operations only the solver used are then unused.
-#[cfg_attr(all(target_arch = "x86_64", target_feature = "avx2"), allow(dead_code))]
 pub(crate) mod wide;
-#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+#[cfg(target_arch = "x86_64")]
 pub(crate) mod wide8;
 
 use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};

@@ -19,40 +19,6 @@ use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub, SubAssig
 /// Lanes of [`F4`].
 pub(crate) const LANES4: usize = 4;
 
-/// The wide contact solver's lane vectors: [`F4`], [`M4`] and [`V4`] (SSE, four lanes),
-/// or in a build for AVX2 (`-C target-feature=+avx2`, as Box2D's `BOX2D_AVX2`) the
-/// eight-lane `wide8::F8`, `M8` and `V8`. A lane computes the same expressions either way;
-/// only how many constraints a group holds changes (and so, for a group-wide branch, which
-/// branch a lane takes: they agree to the bit but for the sign of a zero velocity, see
-/// `crate::SOLVER_LANES`).
-#[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
-pub(crate) use self::{F4 as FL, M4 as ML, V4 as VL};
-#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
-pub(crate) use super::wide8::{F8 as FL, M8 as ML, V8 as VL};
-
-/// Lanes per wide constraint (of [`FL`]).
-pub(crate) const LANES: usize = core::mem::size_of::<FL>() / 4;
-
-/// `LANES` 16-byte rows (one per lane: a body's state row, a contact's input row) as four
-/// lane vectors: lane `l` of output `i` is element `i` of row `l` (the 4×4 [`transpose`]
-/// with four lanes).
-#[inline(always)]
-pub(crate) fn rows_to_lanes(rows: [F4; LANES]) -> [FL; 4] {
-    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
-    return transpose(rows);
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
-    return super::wide8::rows_to_lanes8(rows);
-}
-
-/// The inverse of [`rows_to_lanes`]: four lane vectors as `LANES` 16-byte rows.
-#[inline(always)]
-pub(crate) fn lanes_to_rows(cols: [FL; 4]) -> [F4; LANES] {
-    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
-    return transpose(cols);
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
-    return super::wide8::lanes_to_rows8(cols);
-}
-
 /// The register a lane vector lives in: an SSE register on x86-64 (so LLVM keeps it whole
 /// where branches meet, instead of taking a four-`f32` array apart into scalars there and
 /// packing it again: ~80 instructions per group of the biased solve pass, found with
@@ -120,7 +86,7 @@ macro_rules! lane_array {
         }
     };
 }
-#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+#[cfg(target_arch = "x86_64")]
 pub(crate) use lane_array;
 lane_array!(F4, f32, LANES4, as_lanes::f, as_lanes::f_mut);
 lane_array!(M4, u32, LANES4, as_lanes::m, as_lanes::m_mut);
@@ -290,14 +256,14 @@ mod sse {
 }
 
 /// The SSE register of an `F4` (for the eight-lane type's row transposes).
-#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub(crate) fn sse_register(x: F4) -> core::arch::x86_64::__m128 {
     x.0
 }
 
 /// An `F4` from its SSE register.
-#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub(crate) fn from_sse_register(v: core::arch::x86_64::__m128) -> F4 {
     F4(v)
@@ -428,6 +394,20 @@ impl F4 {
             M4::new(lanes!(|i| mask(self[i].to_bits() & bits == bits)))
         )
     }
+}
+
+/// `core::array::from_fn`, always inlined. The wide solver's eight-lane build is compiled
+/// for AVX2 function by function (`solver::lanes8`): a closure handed to `array::from_fn`
+/// or `array::map` runs inside `core`'s code, which is not, so it stays a call per element
+/// (and one not compiled for AVX2 at all leaves each AVX intrinsic out of line). Here the
+/// loop is inlined into the caller, and the closure with it.
+#[inline(always)]
+pub(crate) fn array_of<T: Copy + Default, const N: usize>(mut f: impl FnMut(usize) -> T) -> [T; N] {
+    let mut out = [T::default(); N];
+    for (i, x) in out.iter_mut().enumerate() {
+        *x = f(i);
+    }
+    out
 }
 
 /// The 4×4 transpose: lane `j` of output `i` is lane `i` of input `j` (turns four bodies'
@@ -838,7 +818,7 @@ macro_rules! lane_vectors {
         }
     };
 }
-#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+#[cfg(target_arch = "x86_64")]
 pub(crate) use lane_vectors;
 
 lane_vectors!(V4, F4, "Four 2D vectors, one per lane.");

@@ -1,12 +1,13 @@
-//! Eight-lane floats for the wide contact solver in a build for AVX2 (`-C
-//! target-feature=+avx2`, as Box2D's `BOX2D_AVX2` option): the same operations as
+//! Eight-lane floats for the wide contact solver's eight-lane build (`solver::lanes8`,
+//! compiled for AVX2 and chosen at run time on a CPU that has it): the same operations as
 //! [`super::wide::F4`] and [`super::wide::M4`], each one AVX instruction on a 256-bit
 //! register. Every operation is lane-wise plain IEEE arithmetic (no fused multiply-add, no
 //! approximate reciprocal), so a lane computes bit for bit what the same scalar expression
 //! computes, as with four lanes.
 //!
-//! Used only through [`super::wide::FL`], [`super::wide::ML`] and [`super::wide::VL`],
-//! which are these types in such a build and the four-lane ones otherwise.
+//! Used only through `solver::lanes8::wide::{FL, ML, VL}`, in functions compiled for AVX2:
+//! the operations here are `#[inline(always)]` and take the AVX instructions only once
+//! inlined there (out of line, each intrinsic would be a call).
 
 use super::wide::F4;
 use core::arch::x86_64::{__m128, __m256, __m256i};
@@ -39,10 +40,11 @@ mod avx {
         ($($name:ident $(<$c:ident>)? ($($a:ident: $t:ty),*) -> $r:ty;)*) => {$(
             #[inline(always)]
             pub fn $name$(<const $c: i32>)?($($a: $t),*) -> $r {
-                // SAFETY: this module is compiled only with AVX2 enabled for the whole
-                // build (`cfg(target_feature = "avx2")`), so every CPU the build runs on
-                // has AVX and AVX2; these intrinsics work on values only: they read and
-                // write no memory.
+                // SAFETY: the CPU has AVX and AVX2 wherever an eight-lane value exists:
+                // they are made and used only in `solver::lanes8`, whose solver the world
+                // takes only after `is_x86_feature_detected!("avx2")` (`solver::Contacts`),
+                // or in a crate compiled for AVX2 as a whole. These intrinsics work on
+                // values only: they read and write no memory.
                 unsafe { core::arch::x86_64::$name$(::<$c>)?($($a),*) }
             }
         )*};

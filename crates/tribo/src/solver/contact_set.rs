@@ -32,19 +32,23 @@
 //!
 //! [`team_loop`]: ContactSolver::team_loop
 
-use super::contact_solver::{
-    build_constraint, end_substep_one, estimate, is_new_resting, record_approach, restitution_one, solve_one,
-    store_impulses, warm_start_one, ConstraintBodies, ContactConstraint, ContactInput, StepSoftness, MASS_RATIO_GROUP,
-    MAX_ESTIMATE_SWEEPS, MAX_LOCAL_SWEEPS, ONGOING_ESTIMATE_SWEEPS,
-};
 use super::contact_wide::{self, StoredContact, WideCold, WideContact, WideDerived, WideHead, COLORS, DYNAMIC_COLORS};
-use super::wide::LANES;
-use super::{
-    any_load, claim_each, for_each_chunk_mut4, integrate_positions_range, integrate_velocity_one, BodySim,
-    ConstraintSet, SharedState, SolverBody, StateCell, StateRead, StepContext, TeamProgress,
-};
+use super::wide::{array_of, LANES};
 use crate::collision::contact::{Contact, NO_COLOUR};
 use crate::math::Vec2;
+use crate::solver::candidates::{
+    mass_ratio, Candidate, Candidates, ColourKey, COLOUR_FLAGS, FAST, FRESH, KEY_DYNAMIC_A, KEY_DYNAMIC_B, KEY_RATIO,
+    KEY_RESTITUTION, ORDER_FLAGS, SINGLE,
+};
+use crate::solver::contact_solver::{
+    build_constraint, end_substep_one, estimate, is_new_resting, record_approach, restitution_one, solve_one,
+    store_impulses, warm_start_one, ContactConstraint, StepSoftness, MAX_ESTIMATE_SWEEPS, MAX_LOCAL_SWEEPS,
+    ONGOING_ESTIMATE_SWEEPS,
+};
+use crate::solver::{
+    any_load, claim_each, for_each_chunk_mut4, integrate_positions_range, integrate_velocity_one, BodySim,
+    ConstraintSet, SharedState, StateCell, StateRead, StepContext, TeamProgress,
+};
 use crate::world::Stopwatch;
 
 /// Where a constraint lives during the substeps.
@@ -54,163 +58,6 @@ enum Slot {
     Wide { group: u32, lane: u8 },
     /// `overflow[index]`.
     Overflow(u32),
-}
-
-/// One touching contact to solve this step: what building its constraint reads.
-///
-/// `repr(C)`, 16-byte aligned, 160 bytes (contact and bodies, then the solver input). What
-/// the colouring reads is a [`ColourKey`], in an array of its own.
-#[derive(Clone, Copy, Debug)]
-#[repr(C, align(16))]
-pub(crate) struct Candidate {
-    pub contact: u32,
-    pub bodies: ConstraintBodies,
-    pub input: ContactInput,
-}
-
-impl Candidate {
-    /// Writes the candidate of contact `contact` (record `c`, between the bodies of solver
-    /// entries `ba` and `bb`) in place, and its colouring key into `key` (`colour`: the
-    /// contact's colour last step): the 160-byte candidate built on the stack and then
-    /// copied into its slot cost a `memcpy` per touching contact on top of the writes
-    /// (large_pyramid: ~2 % of the step). The bodies' part is read from the solver entries
-    /// here, not passed in built: a record just written field by field on the stack and
-    /// copied by 16-byte loads cannot be forwarded from the store buffer (tumbler: 44 % of
-    /// this function's samples waited on that copy).
-    pub fn fill(
-        &mut self,
-        contact: u32,
-        colour: u8,
-        ba: &SolverBody,
-        bb: &SolverBody,
-        c: &Contact,
-        key: &mut ColourKey,
-    ) {
-        self.contact = contact;
-        self.bodies = ConstraintBodies {
-            index_a: ba.index,
-            index_b: bb.index,
-            inv_mass_a: ba.inv_mass,
-            inv_i_a: ba.inv_i,
-            inv_mass_b: bb.inv_mass,
-            inv_i_b: bb.inv_i,
-            center_a: ba.center,
-            center_b: bb.center,
-        };
-        self.input.fill(c);
-        let input = &self.input;
-        let b = &self.bodies;
-        let flag = |on: bool, bit: u8| if on { bit } else { 0 };
-        let [moving_a, moving_b] = b.moving();
-        *key = ColourKey {
-            index_a: b.index_a,
-            index_b: b.index_b,
-            colour,
-            flags: flag(fast_first(input), FAST)
-                | flag(input.count < 2, SINGLE)
-                | flag(input.may_be_new_resting(), FRESH)
-                | flag(moving_a, KEY_DYNAMIC_A)
-                | flag(moving_b, KEY_DYNAMIC_B)
-                | flag(mass_ratio(b).is_some(), KEY_RATIO)
-                | flag(input.restitution > 0.0, KEY_RESTITUTION),
-        };
-    }
-
-    /// A placeholder for a contact that is not solved this step.
-    pub const SKIP: Candidate = Candidate {
-        contact: u32::MAX,
-        bodies: ConstraintBodies::STATIC,
-        input: ContactInput::EMPTY,
-    };
-}
-
-/// What the colouring pass reads of a candidate: 12 bytes, in an array of its own, so the
-/// serial colouring streams these instead of one cache line of each 160-byte candidate
-/// (large_pyramid: 15 000 lines a step).
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct ColourKey {
-    index_a: u32,
-    index_b: u32,
-    /// The colour the contact had when last solved ([`NO_COLOUR`]: none), tried first.
-    colour: u8,
-    /// [`FAST`], [`FRESH`], [`KEY_DYNAMIC_A`], [`KEY_DYNAMIC_B`], [`KEY_RATIO`].
-    flags: u8,
-}
-
-impl ColourKey {
-    /// The solver slots of the constraint's two bodies (0: a static body).
-    #[inline]
-    pub fn slots(&self) -> (u32, u32) {
-        (self.index_a, self.index_b)
-    }
-
-    /// The solver slots of the two bodies when both are awake dynamic bodies (the pairs
-    /// that join islands), else None.
-    #[inline]
-    pub fn dynamic_pair(&self) -> Option<(u32, u32)> {
-        let both = KEY_DYNAMIC_A | KEY_DYNAMIC_B;
-        (self.flags & both == both).then_some((self.index_a, self.index_b))
-    }
-}
-
-/// Flag of a [`ColourKey`]: side A is a moving body (takes a colour).
-const KEY_DYNAMIC_A: u8 = 0x01;
-/// Flag of a [`ColourKey`]: side B is a moving body.
-const KEY_DYNAMIC_B: u8 = 0x02;
-/// Flag of a [`ColourKey`]: one body is more than [`MASS_RATIO_GROUP`] times heavier than
-/// the other (the colouring then reads the whole candidate, see [`mass_ratio`]).
-const KEY_RATIO: u8 = 0x04;
-/// Flag of a [`ColourKey`]: the contact has restitution.
-const KEY_RESTITUTION: u8 = 0x08;
-
-/// For two bodies with mass, one more than [`MASS_RATIO_GROUP`] times heavier than the
-/// other: (mass ratio, light body, heavy body, whether A is the light one).
-#[inline]
-fn mass_ratio(b: &ConstraintBodies) -> Option<(f32, u32, u32, bool)> {
-    if !(b.inv_mass_a > 0.0 && b.inv_mass_b > 0.0) {
-        return None;
-    }
-    // The light body, and the direction from it to the heavy one (the normal points from A
-    // to B).
-    let out = if b.inv_mass_a > b.inv_mass_b {
-        (b.inv_mass_a / b.inv_mass_b, b.index_a, b.index_b, true)
-    } else {
-        (b.inv_mass_b / b.inv_mass_a, b.index_b, b.index_a, false)
-    };
-    (out.0 > MASS_RATIO_GROUP).then_some(out)
-}
-
-/// The candidates of a step: `slots` (and their colouring `keys`) indexed by contact,
-/// `list` the contacts to solve (in contact order); candidate `i` is `slots[list[i]]`.
-#[derive(Clone, Copy)]
-pub(crate) struct Candidates<'a> {
-    slots: &'a [Candidate],
-    keys: &'a [ColourKey],
-    list: &'a [u32],
-}
-
-impl<'a> Candidates<'a> {
-    pub fn new(slots: &'a [Candidate], keys: &'a [ColourKey], list: &'a [u32]) -> Candidates<'a> {
-        Candidates { slots, keys, list }
-    }
-
-    /// The `i`-th candidate.
-    #[inline]
-    pub fn get(&self, i: usize) -> Option<&'a Candidate> {
-        self.slots.get(*self.list.get(i)? as usize)
-    }
-
-    /// The candidates in order.
-    pub fn iter(&self) -> impl Iterator<Item = &'a Candidate> + '_ {
-        self.list.iter().filter_map(|&ci| self.slots.get(ci as usize))
-    }
-
-    /// The candidates' contacts and colouring keys, in order.
-    fn keys(&self) -> impl Iterator<Item = (u32, &'a ColourKey)> + '_ {
-        self.list
-            .iter()
-            .filter_map(|&ci| Some((ci, self.keys.get(ci as usize)?)))
-    }
 }
 
 /// A light body's constraints, solved again ⌈M/m⌉ times per relax pass.
@@ -237,7 +84,7 @@ pub(crate) struct ContactSolver {
     /// Constraints whose points are all new this step and touching (those the warm-start
     /// estimate may take).
     fresh: Vec<Slot>,
-    /// Gravity or a force acts on some body this step ([`super::any_load`]): the helpers
+    /// Gravity or a force acts on some body this step ([`crate::solver::any_load`]): the helpers
     /// for carrying loads (estimate, mass-ratio groups) run only then.
     loaded: bool,
     /// Some coloured constraint has restitution (else the restitution pass skips the
@@ -453,46 +300,15 @@ const _: () = assert!(COLORS <= 32);
 
 /// No colour: the constraint goes to the overflow list.
 const OVERFLOW: u8 = u8::MAX;
-
-/// Flag in a constraint's colour byte: it goes to the front of its colour ([`fast_first`]).
-const FAST: u8 = 0x40;
-/// Flag in a constraint's colour byte: all its points are new this step and touching
-/// (`ContactInput::may_be_new_resting`).
-const FRESH: u8 = 0x20;
 const _: () = assert!(COLORS <= FRESH as usize);
-/// Flag in a constraint's colour byte (and a [`ColourKey`]'s): it has one point or none,
-/// and goes to the back of its colour, after the two-point constraints the front does not
-/// take. Groups of single points then take the wide solver's one-point path, which skips
-/// the second point and the 2×2 block, and the two-point groups find a block solution in
-/// every lane more often. In tumbler a quarter of the lanes have one point; mixed in with
-/// two-point lanes they sent two groups in three to the general path (tumbler's step
-/// −3.5 %, junkyard's −8 %). Like [`FAST`], it only orders a colour: a kept layout does not
-/// compare it.
-const SINGLE: u8 = 0x80;
-/// The flags that only order a colour ([`FAST`], [`SINGLE`]): a kept layout does not
-/// compare them.
-const ORDER_FLAGS: u8 = FAST | SINGLE;
-/// Every flag a constraint's colour byte carries beside its colour.
-const COLOUR_FLAGS: u8 = ORDER_FLAGS | FRESH;
 // No coloured constraint's byte reads as OVERFLOW.
 const _: () = assert!((COLORS as u8 - 1) | COLOUR_FLAGS != OVERFLOW);
-
-/// Whether a constraint goes to the front of its colour: a face contact whose two points
-/// both carried load last step, which will most likely keep both points pushing and take
-/// the wide solver's fast path (the 2×2 block with both points active). The others —
-/// faces touching on one corner, speculative pairs not yet touching, and behind those the
-/// single points ([`SINGLE`]) — go to the back, so the fast path is not lost to a whole
-/// group of four because one lane needs the general case. Constraints of one colour share
-/// no moving body, so their order inside the colour does not change any result.
-#[inline]
-fn fast_first(input: &ContactInput) -> bool {
-    input.count == 2 && input.points[0].normal_impulse > 0.0 && input.points[1].normal_impulse > 0.0
-}
 
 impl ContactSolver {
     /// Builds the step's constraints from `candidates` (in contact order, each carrying its
     /// contact's solver input); `states` and `sims` are the awake bodies' solver states and
-    /// step data, `loaded` whether any of them [`super::loads`] (found while they were made).
+    /// step data, `loaded` whether any of them [`crate::solver::loads`] (found while they were made).
+    #[super::lane_fn]
     pub fn build<S: StateRead + Sync>(
         &mut self,
         ctx: &StepContext,
@@ -524,7 +340,7 @@ impl ContactSolver {
                     if let Some(ahead) = lane_candidates.get(g + PREFETCH_GROUPS) {
                         for &i in ahead {
                             if let Some(cand) = candidates.get(i as usize) {
-                                super::prefetch(cand);
+                                crate::solver::prefetch(cand);
                             }
                         }
                     }
@@ -536,14 +352,14 @@ impl ContactSolver {
                         colds.get(k + PREFETCH_GROUPS),
                         derived.get(k + PREFETCH_GROUPS),
                     ) {
-                        super::prefetch(h);
-                        super::prefetch(w);
-                        super::prefetch(c);
-                        super::prefetch(d);
+                        crate::solver::prefetch(h);
+                        crate::solver::prefetch(w);
+                        crate::solver::prefetch(c);
+                        crate::solver::prefetch(d);
                     }
-                    let lanes = lane_candidates[g].map(|i| {
+                    let lanes = array_of(|l| {
                         candidates
-                            .get(i as usize)
+                            .get(lane_candidates[g][l] as usize)
                             .map(|cand| (cand.contact, &cand.input, &cand.bodies))
                     });
                     if let (Some(h), Some(w), Some(cold), Some(dv)) =
@@ -564,6 +380,7 @@ impl ContactSolver {
 
     /// Steps 1–3 of the build: colours, layout, slots (and the overflow constraints, built
     /// whole); `light` gets the light bodies under heavy ones.
+    #[super::lane_fn]
     fn colour_and_lay_out<S: StateRead + Sync>(
         &mut self,
         ctx: &StepContext,
@@ -749,6 +566,7 @@ impl ContactSolver {
     /// many_pyramids all but the first steps keep their layout; a pile in motion (tumbler)
     /// fails at once. `light` gets the light bodies under heavy ones, as the colouring
     /// collects them.
+    #[super::lane_fn]
     fn same_layout(
         &self,
         parallel: bool,
@@ -829,6 +647,7 @@ impl ContactSolver {
 
     /// A candidate between a light body and one more than [`MASS_RATIO_GROUP`] times
     /// heavier that rests on it: (light body state, its sweeps).
+    #[super::lane_fn]
     fn light_body(&self, cand: &Candidate, sims: &[BodySim]) -> Option<(u32, u32)> {
         // Only where the heavy body rests on the light one: it lies above it against
         // gravity (a heavy container holding light bodies, Box2D's tumbler drum at 64 000
@@ -872,6 +691,7 @@ impl ContactSolver {
     /// Debug builds: no moving body appears twice in one colour (the threads' shared
     /// states rely on it, see [`SharedState`]).
     #[cfg(debug_assertions)]
+    #[super::lane_fn]
     fn check_colours(&self, bodies: usize) {
         // The passes find a group's ready-made part by its index.
         debug_assert_eq!(self.derived.len(), self.head.len());
@@ -895,7 +715,8 @@ impl ContactSolver {
     /// [`MAX_LOCAL_SWEEPS`]) extra times per relax pass. Sequential impulses move momentum
     /// through a light body between a heavy one and the ground only at a rate of about m/M
     /// per sweep, so a 100:1 stack needs ~100 sweeps where one is enough for equal masses.
-    /// Only when some body is loaded ([`super::any_load`]).
+    /// Only when some body is loaded ([`crate::solver::any_load`]).
+    #[super::lane_fn]
     fn build_groups(&mut self, mut light: Vec<(u32, u32)>, candidates: Candidates<'_>) {
         if light.is_empty() {
             return;
@@ -921,6 +742,7 @@ impl ContactSolver {
     }
 
     /// The scalar constraint at a slot, with its current state.
+    #[super::lane_fn]
     fn get(&self, slot: Slot) -> ContactConstraint {
         match slot {
             Slot::Wide { group, lane } => {
@@ -933,6 +755,7 @@ impl ContactSolver {
 
     /// Writes a scalar constraint's state back to its slot (`full`: geometry and preload
     /// too, after the estimate).
+    #[super::lane_fn]
     fn put(&mut self, slot: Slot, cc: &ContactConstraint, full: bool) {
         match slot {
             Slot::Wide { group, lane } => {
@@ -969,6 +792,7 @@ impl ContactSolver {
     /// layout only roughly (`World::reorder_contacts` allows one break in three), and cut
     /// into eight runs large_pyramid had 1 509 contacts a step to write after, serially,
     /// against 85 with two runs (store +30 % on two threads).
+    #[super::lane_fn]
     pub fn store<S: StateRead + Sync>(&mut self, ctx: &StepContext, states: &[S], contacts: &mut [Option<Contact>]) {
         let groups = self.head.len();
         let tasks = if ctx.parallel {
@@ -1032,6 +856,7 @@ impl ContactSolver {
     /// The store of the groups in `range`, into `contacts`, the part of the contact list
     /// from contact `base` on; a lane whose contact lies outside it goes to `strays`
     /// (contact, colour, what it stores).
+    #[super::lane_fn]
     fn store_groups<S: StateRead>(
         &self,
         ctx: &StepContext,
@@ -1055,7 +880,7 @@ impl ContactSolver {
                 for (&cand, &contact) in ahead.iter().zip(&ahead_cold.contact) {
                     if cand != u32::MAX {
                         if let Some(c) = contacts.get(at(contact)) {
-                            super::prefetch_lines(c, 2);
+                            crate::solver::prefetch_lines(c, 2);
                         }
                     }
                 }
@@ -1081,12 +906,12 @@ impl ContactSolver {
     }
 }
 
-impl ConstraintSet for ContactSolver {
-    fn has_new_contacts(&self) -> bool {
-        self.loaded && !self.fresh.is_empty()
-    }
+impl ContactSolver {
+    // The passes of `ConstraintSet` (the trait's methods below call these).
 
-    fn estimate_new_contacts<S: StateCell>(&mut self, ctx: &StepContext, trial: &[S]) -> bool {
+    /// [`ConstraintSet::estimate_new_contacts`].
+    #[super::lane_fn]
+    fn estimate_new<S: StateCell>(&mut self, ctx: &StepContext, trial: &[S]) -> bool {
         let mut subset = Vec::new();
         let mut slots = Vec::new();
         for &slot in &self.fresh {
@@ -1119,7 +944,9 @@ impl ConstraintSet for ContactSolver {
         true
     }
 
-    fn warm_start<S: StateCell>(&mut self, _ctx: &StepContext, states: &[S]) {
+    /// [`ConstraintSet::warm_start`].
+    #[super::lane_fn]
+    fn warm_start_pass<S: StateCell>(&mut self, states: &[S]) {
         for cc in &mut self.overflow {
             warm_start_one(cc, states);
         }
@@ -1131,7 +958,9 @@ impl ConstraintSet for ContactSolver {
         }
     }
 
-    fn solve<S: StateCell>(&mut self, ctx: &StepContext, states: &[S], use_bias: bool, elapsed: f32) {
+    /// [`ConstraintSet::solve`].
+    #[super::lane_fn]
+    fn solve_pass<S: StateCell>(&mut self, ctx: &StepContext, states: &[S], use_bias: bool, elapsed: f32) {
         for cc in &mut self.overflow {
             solve_one(cc, states, ctx, use_bias, elapsed);
         }
@@ -1185,24 +1014,9 @@ impl ConstraintSet for ContactSolver {
         self.groups = groups;
     }
 
-    fn end_substep(&mut self) {
-        // Wide lanes added their totals at the end of the relax pass.
-        for cc in &mut self.overflow {
-            end_substep_one(cc);
-        }
-    }
-
-    fn substeps_team(
-        &mut self,
-        ctx: &StepContext,
-        sims: &[BodySim],
-        states: &[SharedState],
-        times: &mut [f32; 5],
-    ) -> bool {
-        self.team_loop(ctx, sims, states, times)
-    }
-
-    fn restitution<S: StateCell>(&mut self, states: &[S]) {
+    /// [`ConstraintSet::restitution`].
+    #[super::lane_fn]
+    fn restitution_pass<S: StateCell>(&mut self, states: &[S]) {
         for cc in &mut self.overflow {
             restitution_one(cc, states);
         }
@@ -1225,6 +1039,55 @@ impl ConstraintSet for ContactSolver {
     }
 }
 
+// In the eight-lane build the passes are compiled for AVX2 (`#[super::lane_fn]`), and
+// calling one from here is `unsafe`: sound, since that build's solver is only ever made on
+// a CPU with AVX2 (`solver::Contacts::new`). In the four-lane build the blocks are plain
+// calls (`unused_unsafe`).
+#[allow(unsafe_code, unused_unsafe)]
+impl ConstraintSet for ContactSolver {
+    fn has_new_contacts(&self) -> bool {
+        self.loaded && !self.fresh.is_empty()
+    }
+
+    fn estimate_new_contacts<S: StateCell>(&mut self, ctx: &StepContext, trial: &[S]) -> bool {
+        // SAFETY: see the impl.
+        unsafe { self.estimate_new(ctx, trial) }
+    }
+
+    fn warm_start<S: StateCell>(&mut self, _ctx: &StepContext, states: &[S]) {
+        // SAFETY: see the impl.
+        unsafe { self.warm_start_pass(states) }
+    }
+
+    fn solve<S: StateCell>(&mut self, ctx: &StepContext, states: &[S], use_bias: bool, elapsed: f32) {
+        // SAFETY: see the impl.
+        unsafe { self.solve_pass(ctx, states, use_bias, elapsed) }
+    }
+
+    fn end_substep(&mut self) {
+        // Wide lanes added their totals at the end of the relax pass.
+        for cc in &mut self.overflow {
+            end_substep_one(cc);
+        }
+    }
+
+    fn substeps_team(
+        &mut self,
+        ctx: &StepContext,
+        sims: &[BodySim],
+        states: &[SharedState],
+        times: &mut [f32; 5],
+    ) -> bool {
+        // SAFETY: see the impl.
+        unsafe { self.team_loop(ctx, sims, states, times) }
+    }
+
+    fn restitution<S: StateCell>(&mut self, states: &[S]) {
+        // SAFETY: see the impl.
+        unsafe { self.restitution_pass(states) }
+    }
+}
+
 impl ContactSolver {
     /// The worker-team substep loop (see [`ConstraintSet::substeps_team`]): one job per
     /// thread of the pool for all substeps; each integrates blocks of bodies and solves
@@ -1236,6 +1099,7 @@ impl ContactSolver {
     /// solved which block. Only for steps without overflow constraints and mass-ratio
     /// groups (scalar work the team would have to serialise); those run the per-colour
     /// path.
+    #[super::lane_fn]
     fn team_loop(&mut self, ctx: &StepContext, sims: &[BodySim], states: &[SharedState], times: &mut [f32; 5]) -> bool {
         let threads = rayon::current_num_threads();
         if threads < 2 || !self.overflow.is_empty() || !self.groups.is_empty() || self.wide.is_empty() {
@@ -1293,7 +1157,7 @@ impl ContactSolver {
         // other thread has started when this one is done runs here, and finds every pass
         // done (rayon's scope runs its own pending jobs while it waits), so the step never
         // waits for a thread that is not running.
-        super::awake::stage(threads, || {
+        crate::solver::awake::stage(threads, || {
             rayon::scope(|s| {
                 for k in 1..threads {
                     let work = &work;
@@ -1319,6 +1183,7 @@ impl ContactSolver {
     /// worse, never wrong: every block is still solved once per pass.
     /// [`ContactSolver::team_blocks`]' group boundaries: per colour, per part, the groups
     /// where each thread's share starts, then the part's end.
+    #[super::lane_fn]
     fn team_cuts(&self, threads: usize, per_thread: usize) -> TeamCuts {
         let owner_key = |h: &WideHead| {
             let (a, b) = (h.index_a[0], h.index_b[0]);
@@ -1346,6 +1211,7 @@ impl ContactSolver {
         cuts
     }
 
+    #[super::lane_fn]
     fn team_blocks(&mut self, threads: usize, per_thread: usize) -> Vec<Vec<TeamPart<GroupBlock<'_>>>> {
         // Group boundaries, in order: per colour, per part, per thread. Found by binary
         // searches over the groups' first lanes, lines the build has just written on
@@ -1396,6 +1262,7 @@ impl ContactSolver {
     }
 
     /// Refreshes a copy's state from its slot (the coloured passes changed it).
+    #[super::lane_fn]
     fn sync_from(&self, slot: Slot, cc: &mut ContactConstraint) {
         match slot {
             Slot::Wide { group, lane } => {
@@ -1407,7 +1274,31 @@ impl ContactSolver {
     }
 }
 
+// The build's entries for the world, `unsafe` for the same reason as the passes above.
+#[allow(unsafe_code, unused_unsafe)]
+impl crate::solver::WideContacts for ContactSolver {
+    fn build_step<S: StateRead + Sync>(
+        &mut self,
+        ctx: &StepContext,
+        states: &[S],
+        sims: &[BodySim],
+        candidates: Candidates<'_>,
+        loaded: bool,
+        up: Vec2,
+    ) {
+        self.up = up;
+        // SAFETY: see `impl ConstraintSet for ContactSolver`.
+        unsafe { self.build(ctx, states, sims, candidates, loaded) }
+    }
+
+    fn store_step<S: StateRead + Sync>(&mut self, ctx: &StepContext, states: &[S], contacts: &mut [Option<Contact>]) {
+        // SAFETY: see `impl ConstraintSet for ContactSolver`.
+        unsafe { self.store(ctx, states, contacts) }
+    }
+}
+
 #[cfg(test)]
+#[super::lane_tests]
 mod tests {
     use super::*;
     use core::sync::atomic::{AtomicBool, AtomicU32, Ordering::Relaxed};

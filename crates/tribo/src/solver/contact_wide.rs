@@ -33,14 +33,14 @@
 //! agrees with the scalar solve to 1e-4 (`two_point_solve_matches_scalar_solve`). A
 //! contact is solved one way for a whole step.
 
-use super::contact_solver::{
+use super::wide::{array_of, lanes_to_rows, rows_to_lanes, F4, FL, LANES, ML, VL};
+use crate::collision::contact::{Contact, FrictionState, PointState};
+use crate::math::Vec2;
+use crate::solver::contact_solver::{
     fresh_point_sticks, kinetic_energy_of, ConstraintBodies, ConstraintPoint, ContactConstraint, ContactInput,
     StepSoftness, INPUT_FRESH, INPUT_STICK,
 };
-use super::wide::{lanes_to_rows, rows_to_lanes, F4, FL, LANES, ML, VL};
-use super::{StateCell, StateRead, StepContext};
-use crate::collision::contact::{Contact, FrictionState, PointState};
-use crate::math::Vec2;
+use crate::solver::{StateCell, StateRead, StepContext};
 
 /// Number of colours (Box2D v3 uses 24, the last for overflow).
 pub(crate) const COLORS: usize = 24;
@@ -190,7 +190,11 @@ impl WideDerived {
     fn new(friction: (VL, VL), t: VL, h: &WideHead, w: &WideContact) -> WideDerived {
         WideDerived {
             fr_moments: moments(friction, t),
-            normal_moments: h.points.map(|p| moments((p.r_a, p.r_b), h.normal)),
+            // Spelled out, not `map`ped (see `point_impulse`).
+            normal_moments: [
+                moments((h.points[0].r_a, h.points[0].r_b), h.normal),
+                moments((h.points[1].r_a, h.points[1].r_b), h.normal),
+            ],
             i11: w.k22 * w.inv_det,
             i12: -w.k12 * w.inv_det,
             i22: w.k11 * w.inv_det,
@@ -226,8 +230,8 @@ fn gather<S: StateRead>(states: &[S], idx: &[u32; LANES]) -> WideBody {
     for (row, &i) in s.iter_mut().zip(idx) {
         *row = states[i as usize].rows();
     }
-    let [vx, vy, w, touched] = rows_to_lanes(s.map(|r| r[0]));
-    let [dpx, dpy, _, dq_s] = rows_to_lanes(s.map(|r| r[1]));
+    let [vx, vy, w, touched] = rows_to_lanes(array_of(|l| s[l][0]));
+    let [dpx, dpy, _, dq_s] = rows_to_lanes(array_of(|l| s[l][1]));
     WideBody {
         v: VL { x: vx, y: vy },
         w,
@@ -409,11 +413,20 @@ fn lane_softness(h: &WideHead, soft: &StepSoftness) -> (FL, FL, FL) {
     )
 }
 
+/// Point `i`'s impulse λn_i n + λt_i t ([`warm_start`]). A function, not a closure: in the
+/// eight-lane build only functions marked `lane_fn` and what is always inlined into them
+/// are compiled for AVX2; a closure inside an always-inlined function is not, and may stay
+/// out of line (as may one given to `array::map`).
+#[inline(always)]
+fn point_impulse(c: &WideHead, n: VL, t: VL, i: usize) -> VL {
+    n.scale(c.points[i].normal_impulse) + t.scale(c.tangent_impulse * tangent_share(c, i))
+}
+
 /// Re-applies the accumulated impulses at the start of a substep and, in a group with
 /// restitution, records each point's normal velocity before them (restitution's impact
 /// speed; the only reader, so a group without restitution skips it: large_pyramid's warm
 /// start went from 0.305 to 0.279 ms per step).
-#[cfg_attr(all(target_arch = "x86_64", target_feature = "avx2"), inline(always))]
+#[super::lane_inline]
 pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
     let n = c.normal;
     let t = n.right_perp();
@@ -424,8 +437,7 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
     // 0.183 → 0.169 ms a step). What does not depend on the bodies is made before they are
     // gathered: the head's loads then overlap the gather's instead of waiting behind it
     // (warm start −6 % in large_pyramid and tumbler, the same instructions).
-    let [p0, p1] =
-        [0, 1].map(|i| n.scale(c.points[i].normal_impulse) + t.scale(c.tangent_impulse * tangent_share(c, i)));
+    let (p0, p1) = (point_impulse(c, n, t, 0), point_impulse(c, n, t, 1));
     let total = p0 + p1;
     let arms_a = c.points[0].r_a.cross(p0) + c.points[1].r_a.cross(p1);
     let arms_b = c.points[0].r_b.cross(p0) + c.points[1].r_b.cross(p1);
@@ -461,6 +473,7 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
 /// that do not bounce keep their impulses and velocities bit for bit. Unpacking each
 /// bouncing lane into a scalar constraint cost 1.4 ms of a 24 ms step in Box2D's spinner,
 /// where half the lanes bounce.
+#[super::lane_fn]
 pub(crate) fn restitution<S: StateCell>(
     h: &mut WideHead,
     w: &mut WideContact,
@@ -472,9 +485,9 @@ pub(crate) fn restitution<S: StateCell>(
     let e = FL::new(cold.restitution);
     let minus_threshold = -FL::new(cold.restitution_threshold);
     // `contact_solver::bounces` of each point (absent points never bounce).
-    let bounces: [ML; 2] = core::array::from_fn(|i| {
+    let bounces: [ML; 2] = array_of(|i| {
         let p = &w.points[i];
-        ML::from_bools(cold.count.map(|c| c as usize > i))
+        ML::from_bools(array_of(|l| cold.count[l] as usize > i))
             & e.gt(zero)
             & minus_threshold.ge(p.approach)
             & p.max_normal_impulse.gt(zero)
@@ -486,7 +499,7 @@ pub(crate) fn restitution<S: StateCell>(
     let mut b = gather(states, &h.index_b);
     // The bodies' displacements do not change here: nor do the lever arms.
     let shift = capped_shift(h, b.dp - a.dp);
-    let arms = [0, 1].map(|i| lever_arms(h, shift, h.points[i].r_a, h.points[i].r_b));
+    let arms: [(VL, VL); 2] = array_of(|i| lever_arms(h, shift, h.points[i].r_a, h.points[i].r_b));
     let n = h.normal;
     let normal_velocity = |a: &WideBody, b: &WideBody, i: usize| relative_velocity(a, b, arms[i].0, arms[i].1).dot(n);
     // Point `i` takes the impulse `new` in the lanes of `m` (elsewhere not even a zero's
@@ -582,15 +595,19 @@ fn select_velocity(m: ML, x: &WideBody, y: &WideBody) -> WideBody {
 /// same expression).
 #[inline(always)]
 fn kinetic_energy(h: &WideHead, a: &WideBody, b: &WideBody) -> FL {
+    kinetic_part(h.inv_mass_a, h.inv_i_a, a) + kinetic_part(h.inv_mass_b, h.inv_i_b, b)
+}
+
+/// One body's part of [`kinetic_energy`] (a function, not a closure: see
+/// [`point_impulse`]).
+#[inline(always)]
+fn kinetic_part(inv_m: FL, inv_i: FL, s: &WideBody) -> FL {
     let (zero, half) = (FL::ZERO, FL::splat(0.5));
-    let part = |inv_m: FL, inv_i: FL, s: &WideBody| {
-        let lin = inv_m
-            .gt(zero)
-            .select(half * (s.v.x * s.v.x + s.v.y * s.v.y) / inv_m, zero);
-        let ang = inv_i.gt(zero).select(half * s.w * s.w / inv_i, zero);
-        lin + ang
-    };
-    part(h.inv_mass_a, h.inv_i_a, a) + part(h.inv_mass_b, h.inv_i_b, b)
+    let lin = inv_m
+        .gt(zero)
+        .select(half * (s.v.x * s.v.x + s.v.y * s.v.y) / inv_m, zero);
+    let ang = inv_i.gt(zero).select(half * s.w * s.w / inv_i, zero);
+    lin + ang
 }
 
 /// The normal rows of one pass over four constraints (contact_solver::normal_row): bias
@@ -826,6 +843,7 @@ pub(crate) type LaneInput<'a> = Option<(u32, &'a ContactInput, &'a ConstraintBod
 /// at a time and the group is written whole, not field by field per lane. An empty lane
 /// has the static body on both sides, no mass and no impulse: solving it changes nothing.
 #[allow(clippy::too_many_arguments)]
+#[super::lane_fn]
 pub(crate) fn build_group<S: StateRead>(
     head: &mut WideHead,
     w: &mut WideContact,
@@ -857,24 +875,25 @@ pub(crate) fn build_group<S: StateRead>(
     // were skipped) instead of being tested at every column: large_pyramid's build ran
     // 8 % fewer instructions (1 298 → 1 195 a group). Only the tangent impulse of an
     // empty input differs (−0.0), so it is masked.
-    let read: [(&ContactInput, &ConstraintBodies); LANES] = lanes.map(|lane| {
-        lane.map_or((&ContactInput::EMPTY, &ConstraintBodies::STATIC), |(_, input, b)| {
-            (input, b)
-        })
-    });
-    let present = ML::from_bools(lanes.map(|lane| lane.is_some()));
+    // (Loops and `array_of`, not `array::map` and `from_fn`: see `array_of`.)
+    let mut read: [(&ContactInput, &ConstraintBodies); LANES] =
+        [(&ContactInput::EMPTY, &ConstraintBodies::STATIC); LANES];
+    for (r, lane) in read.iter_mut().zip(&lanes) {
+        if let Some((_, input, b)) = *lane {
+            *r = (input, b);
+        }
+    }
+    let present = ML::from_bools(array_of(|l| lanes[l].is_some()));
     // Each lane's bodies (an empty lane: the static body, not written back).
-    let (index_a, index_b) = (read.map(|(_, b)| b.index_a), read.map(|(_, b)| b.index_b));
+    let (index_a, index_b) = (array_of(|l| read[l].1.index_a), array_of(|l| read[l].1.index_b));
     (hd.index_a, hd.index_b) = (index_a, index_b);
-    let each = |f: &dyn Fn(&ContactInput, &ConstraintBodies) -> f32| {
-        FL::new(core::array::from_fn(|l| f(read[l].0, read[l].1)))
-    };
+    let each = |f: &dyn Fn(&ContactInput, &ConstraintBodies) -> f32| FL::new(array_of(|l| f(read[l].0, read[l].1)));
     let count_of = |input: &ContactInput| input.count.min(2);
     // Fields that lie side by side in a candidate come as one 16-byte row per lane,
     // transposed into lanes of each (zeros in an empty lane): with four lanes eight
     // shuffles instead of sixteen single-lane loads and inserts per row.
     let columns = |row: &dyn Fn(&ContactInput, &ConstraintBodies) -> [f32; 4]| {
-        rows_to_lanes(core::array::from_fn(|l| F4::new(row(read[l].0, read[l].1))))
+        rows_to_lanes(array_of(|l| F4::new(row(read[l].0, read[l].1))))
     };
     let [cax, cay, cbx, cby] = columns(&|_, b| b.centre_row());
     let (center_a, center_b) = (VL { x: cax, y: cay }, VL { x: cbx, y: cby });
@@ -885,23 +904,23 @@ pub(crate) fn build_group<S: StateRead>(
     hd.write_a = moving(ma, ia, index_a);
     hd.write_b = moving(mb, ib, index_b);
     // Each point's (x, y, separation, normal impulse); kept where the lane has the point.
-    let point_rows: [[FL; 4]; 2] = core::array::from_fn(|i| columns(&|input, _| input.points[i].row()));
-    let counts = read.map(|(input, _)| count_of(input) as u32);
-    let has: [ML; 2] = core::array::from_fn(|i| ML::above(counts, i as u32));
-    let point: [VL; 2] = core::array::from_fn(|i| VL {
+    let point_rows: [[FL; 4]; 2] = array_of(|i| columns(&|input, _| input.points[i].row()));
+    let counts = array_of(|l| count_of(read[l].0) as u32);
+    let has: [ML; 2] = array_of(|i| ML::above(counts, i as u32));
+    let point: [VL; 2] = array_of(|i| VL {
         x: has[i].select(point_rows[i][0], zero),
         y: has[i].select(point_rows[i][1], zero),
     });
     // Each point's (friction impulse, preload, drift, flags), and its flags as masks (none
     // where the lane lacks the point): the flags come in the transpose with the floats, one
     // word a lane, instead of masks assembled from each lane's bytes.
-    let state_rows: [[FL; 4]; 2] = core::array::from_fn(|i| columns(&|input, _| input.points[i].state_row()));
-    let stick_in: [ML; 2] = core::array::from_fn(|i| has[i] & state_rows[i][3].bits_set(INPUT_STICK));
-    let fresh: [ML; 2] = core::array::from_fn(|i| has[i] & state_rows[i][3].bits_set(INPUT_FRESH));
+    let state_rows: [[FL; 4]; 2] = array_of(|i| columns(&|input, _| input.points[i].state_row()));
+    let stick_in: [ML; 2] = array_of(|i| has[i] & state_rows[i][3].bits_set(INPUT_STICK));
+    let fresh: [ML; 2] = array_of(|i| has[i] & state_rows[i][3].bits_set(INPUT_FRESH));
     // A sticking point's drift carries over (not a fresh one's). Chosen by masks, not a branch
     // per lane: which points stick is data (the branch had missed 3 100 times a step in
     // tumbler, 6 % of its misses).
-    let base_drift: [FL; 2] = core::array::from_fn(|i| (stick_in[i] & !fresh[i]).select(state_rows[i][2], zero));
+    let base_drift: [FL; 2] = array_of(|i| (stick_in[i] & !fresh[i]).select(state_rows[i][2], zero));
     hd.normal = VL {
         x: each(&|input, _| input.normal.x),
         y: each(&|input, _| input.normal.y),
@@ -937,7 +956,7 @@ pub(crate) fn build_group<S: StateRead>(
     let (t0, t1) = (friction_impulse(0), friction_impulse(1));
     let summed = has[1].select(t0 + t1, has[0].select(t0, FL::splat(-0.0)));
     hd.tangent_impulse = present.select(summed, zero);
-    c.base_drift = base_drift.map(|d| *d);
+    c.base_drift = [*base_drift[0], *base_drift[1]];
     let [mu_s, mu_d, restitution, threshold] = columns(&|input, _| input.material_row());
     (c.mu_s, c.mu_d, c.restitution, c.restitution_threshold) = (*mu_s, *mu_d, *restitution, *threshold);
     let [rolling_resistance, tangent_speed, rolling_impulse, _] = columns(&|input, _| input.surface_row());
@@ -965,9 +984,9 @@ pub(crate) fn build_group<S: StateRead>(
     }
     // Each point's friction state: its own, but a new point's is decided from the bodies'
     // velocities (`fresh_point_sticks`), lane by lane where a lane has one.
-    c.fresh = fresh.map(ML::to_bools);
+    c.fresh = [fresh[0].to_bools(), fresh[1].to_bools()];
     let stick = if (fresh[0] | fresh[1]).any() {
-        let mut stick = stick_in.map(ML::to_bools);
+        let mut stick = [stick_in[0].to_bools(), stick_in[1].to_bools()];
         for (l, lane) in lanes.iter().enumerate() {
             let Some((_, input, b)) = *lane else {
                 continue;
@@ -985,9 +1004,9 @@ pub(crate) fn build_group<S: StateRead>(
             }
         }
         c.stick = stick;
-        stick.map(ML::from_stored_bools)
+        [ML::from_stored_bools(stick[0]), ML::from_stored_bools(stick[1])]
     } else {
-        c.stick = stick_in.map(ML::to_bools);
+        c.stick = [stick_in[0].to_bools(), stick_in[1].to_bools()];
         stick_in
     };
     // The row sticks where every point it has sticks (an empty lane: a sticking, empty
@@ -1069,6 +1088,7 @@ impl StoredContact {
     /// Writes what it holds into its contact (the manifold's points and the rolling
     /// impulse).
     #[inline]
+    #[super::lane_fn]
     pub(crate) fn write_into(&self, c: &mut Contact) {
         write_stored(c, self.count, self.rolling_impulse, |i, ps| *ps = self.points[i]);
     }
@@ -1093,6 +1113,7 @@ fn write_stored(c: &mut Contact, count: u8, rolling_impulse: f32, set: impl Fn(u
 /// and the displacement along the tangent four lanes at a time, the sums and the stick/slip
 /// transitions lane by lane), transposed into each lane's rows for the contacts to take in
 /// contact order ([`StoredGroup::write_into`]).
+#[super::lane_fn]
 pub(crate) fn store_group<S: StateRead>(
     h: &WideHead,
     w: &WideContact,
@@ -1191,6 +1212,18 @@ pub(crate) struct StoredPoint {
     preload: FL,
 }
 
+impl StoredPoint {
+    /// The point's states as rows, lane by lane ([`StoredGroup::rows`]); `tangent`: its
+    /// friction impulse. (A method, not a closure: see [`point_impulse`].)
+    #[inline(always)]
+    fn rows(&self, tangent: FL) -> ([F4; LANES], [F4; LANES]) {
+        (
+            lanes_to_rows([self.normal, tangent, self.drift, self.preload]),
+            lanes_to_rows([self.total_normal, self.total_tangent, self.max, self.slip_speed]),
+        )
+    }
+}
+
 /// What the store writes into a group's four contacts ([`store_group`]), lane by lane:
 /// each point's eight floats transposed into two rows in [`PointState`]'s field order,
 /// which [`PointState::set_stored`] writes as two 16-byte stores (before: eight
@@ -1215,15 +1248,10 @@ impl StoredGroup {
     /// friction impulse (the row's, shared by the points).
     #[inline(always)]
     fn new(points: [StoredPoint; 2], tangent: FL, rolling_impulse: FL, count: [u8; LANES]) -> StoredGroup {
-        let rows_of = |p: &StoredPoint| {
-            (
-                lanes_to_rows([p.normal, tangent, p.drift, p.preload]),
-                lanes_to_rows([p.total_normal, p.total_tangent, p.max, p.slip_speed]),
-            )
-        };
-        let ((a0, b0), (a1, b1)) = (rows_of(&points[0]), rows_of(&points[1]));
+        let (a0, b0) = points[0].rows(tangent);
+        let (a1, b1) = points[1].rows(tangent);
         StoredGroup {
-            rows: core::array::from_fn(|l| [[a0[l], b0[l]], [a1[l], b1[l]]]),
+            rows: array_of(|l| [[a0[l], b0[l]], [a1[l], b1[l]]]),
             stick: [points[0].stick.to_bools(), points[1].stick.to_bools()],
             rolling_impulse,
             count,
@@ -1259,6 +1287,7 @@ impl StoredGroup {
     }
 
     /// Lane `l` as a record of its own (for a contact written later, on one thread).
+    #[super::lane_fn]
     pub(crate) fn lane(&self, l: usize) -> StoredContact {
         StoredContact {
             points: [self.point(0, l), self.point(1, l)],
@@ -1271,6 +1300,7 @@ impl StoredGroup {
 /// Copies a scalar constraint into lane `l` (everything: geometry, masses, state) and
 /// makes the group's `derived` part again.
 #[allow(clippy::too_many_arguments)]
+#[super::lane_fn]
 pub(crate) fn pack(
     h: &mut WideHead,
     w: &mut WideContact,
@@ -1367,6 +1397,7 @@ pub(crate) fn pack(
 }
 
 /// Copies the parts of a constraint that change during the substeps into lane `l`.
+#[super::lane_fn]
 pub(crate) fn pack_state(h: &mut WideHead, w: &mut WideContact, l: usize, cc: &ContactConstraint) {
     for i in 0..2 {
         let wp = &mut w.points[i];
@@ -1398,6 +1429,7 @@ pub(crate) fn pack_state(h: &mut WideHead, w: &mut WideContact, l: usize, cc: &C
 }
 
 /// Copies lane `l`'s changing parts back into the scalar constraint.
+#[super::lane_fn]
 pub(crate) fn unpack_state(h: &WideHead, w: &WideContact, l: usize, cc: &mut ContactConstraint) {
     let count = cc.count.min(2);
     let share = if count == 2 { 0.5 } else { 1.0 };
@@ -1418,6 +1450,7 @@ pub(crate) fn unpack_state(h: &WideHead, w: &WideContact, l: usize, cc: &mut Con
 }
 
 /// Rebuilds the scalar constraint of lane `l` (geometry, masses and current state).
+#[super::lane_fn]
 pub(crate) fn unpack_full(
     h: &WideHead,
     w: &WideContact,
@@ -1485,8 +1518,21 @@ pub(crate) fn unpack_full(
 }
 
 #[cfg(test)]
+#[super::lane_tests]
 mod tests {
     use super::*;
+
+    /// `$call` of a function under test. In the eight-lane build the functions are compiled
+    /// for AVX2 and their call is `unsafe`: these tests exist there only in a crate compiled
+    /// for AVX2 as a whole (`lane_tests`), so the CPU has it. A plain call with four lanes.
+    macro_rules! lane_call {
+        ($call:expr) => {{
+            #[allow(unsafe_code, unused_unsafe)]
+            // SAFETY: see above.
+            let out = unsafe { $call };
+            out
+        }};
+    }
     use crate::math::Rot;
     use crate::solver::contact_solver::{build_constraint, restitution_one, store_impulses, InputPoint};
     use crate::solver::BodyState;
@@ -1499,7 +1545,7 @@ mod tests {
         states: &[S],
     ) -> (WideHead, WideContact, WideCold, WideDerived) {
         let (mut h, mut w, mut cold, mut dv) = Default::default();
-        build_group(&mut h, &mut w, &mut cold, &mut dv, lanes, up, ctx, states);
+        lane_call!(build_group(&mut h, &mut w, &mut cold, &mut dv, lanes, up, ctx, states));
         (h, w, cold, dv)
     }
 
@@ -1635,7 +1681,7 @@ mod tests {
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
             let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
             let dyn_side = |m: f32, i: f32| m > 0.0 || i > 0.0;
-            pack(
+            lane_call!(pack(
                 &mut rh,
                 &mut r,
                 &mut rcold,
@@ -1644,7 +1690,7 @@ mod tests {
                 &cc,
                 dyn_side(b.inv_mass_a, b.inv_i_a),
                 dyn_side(b.inv_mass_b, b.inv_i_b),
-            );
+            ));
         }
         assert_eq!(format!("{h:?}"), format!("{rh:?}"));
         assert_eq!(format!("{w:?}"), format!("{r:?}"));
@@ -1687,7 +1733,7 @@ mod tests {
         // coefficient) comes back as the scalar build made it.
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
             let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
-            let u = unpack_full(&h, &w, &cold, &soft, l);
+            let u = lane_call!(unpack_full(&h, &w, &cold, &soft, l));
             let derived = |c: &ContactConstraint| {
                 let soft: Vec<_> = c.points[..c.count].iter().map(|p| p.soft).collect();
                 format!("{:?}", (c.mu_s, c.mu_d, c.rolling_mass, c.k, c.inv_det, c.block, soft))
@@ -1834,7 +1880,16 @@ mod tests {
             let clean = built(f.lanes(), f.up, &ctx, &f.states);
             let (_, _, mut cold, mut dv) = clean;
             let (mut h, mut w) = poisoned(k);
-            build_group(&mut h, &mut w, &mut cold, &mut dv, f.lanes(), f.up, &ctx, &f.states);
+            lane_call!(build_group(
+                &mut h,
+                &mut w,
+                &mut cold,
+                &mut dv,
+                f.lanes(),
+                f.up,
+                &ctx,
+                &f.states
+            ));
             assert_eq!(
                 format!("{:?}", (clean.0, clean.1)),
                 format!("{:?}", (h, w)),
@@ -1921,8 +1976,9 @@ mod tests {
         let d = states[7].dp - states[6].dp;
         assert!(d.length_squared() > h.shift_cap2[3], "lane 3's shift is capped");
         let built = (h, w);
-        let mut scalar: Vec<ContactConstraint> =
-            (0..cases.len()).map(|l| unpack_full(&h, &w, &cold, &soft, l)).collect();
+        let mut scalar: Vec<ContactConstraint> = (0..cases.len())
+            .map(|l| lane_call!(unpack_full(&h, &w, &cold, &soft, l)))
+            .collect();
         let cells = |s: &[BodyState]| -> Vec<core::cell::Cell<BodyState>> {
             s.iter().map(|&s| core::cell::Cell::new(s)).collect()
         };
@@ -1939,7 +1995,7 @@ mod tests {
                 crate::solver::contact_solver::solve_one(cc, &scalar_states, &ctx, bias, elapsed);
             }
             for (l, cc) in scalar.iter().enumerate() {
-                let lane = unpack_full(&h, &w, &cold, &soft, l);
+                let lane = lane_call!(unpack_full(&h, &w, &cold, &soft, l));
                 for (i, (p, q)) in cc.points.iter().zip(&lane.points).enumerate().take(points) {
                     let bits = |p: &ConstraintPoint| (p.normal_impulse.to_bits(), p.tangent_impulse.to_bits());
                     if tol == 0.0 {
@@ -2082,11 +2138,11 @@ mod tests {
                 s
             })
             .collect();
-        let stored = store_group(&h, &w, &cold, &moved, &f.ctx);
-        let out: [StoredContact; LANES] = core::array::from_fn(|l| stored.lane(l));
+        let stored = lane_call!(store_group(&h, &w, &cold, &moved, &f.ctx));
+        let out: [StoredContact; LANES] = core::array::from_fn(|l| lane_call!(stored.lane(l)));
         let (mut slipped, mut pushed) = (false, false);
         for l in 0..3 {
-            let cc = unpack_full(&h, &w, &cold, &f.soft, l);
+            let cc = lane_call!(unpack_full(&h, &w, &cold, &f.soft, l));
             let mut c = crate::collision::contact::blank_contact();
             store_impulses(&cc, &mut c, &moved, &f.ctx);
             let n = cc.count;
@@ -2157,19 +2213,19 @@ mod tests {
         let scalar: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
         let mut expected = Vec::new();
         for l in 0..3 {
-            let mut cc = unpack_full(&h, &w, &cold, &soft, l);
+            let mut cc = lane_call!(unpack_full(&h, &w, &cold, &soft, l));
             restitution_one(&mut cc, &scalar);
             expected.push(cc);
         }
         let wide: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
         let before = (h, w);
-        restitution(&mut h, &mut w, &dv, &cold, &wide);
+        lane_call!(restitution(&mut h, &mut w, &dv, &cold, &wide));
         let bits = |s: BodyState| [s.v.x, s.v.y, s.w].map(f32::to_bits);
         for (k, (x, y)) in wide.iter().zip(&scalar).enumerate() {
             assert_eq!(bits(x.get()), bits(y.get()), "body {k}");
         }
         for (l, cc) in expected.iter().enumerate() {
-            let u = unpack_full(&h, &w, &cold, &soft, l);
+            let u = lane_call!(unpack_full(&h, &w, &cold, &soft, l));
             for i in 0..cc.count {
                 let f = |p: &ConstraintPoint| {
                     [p.normal_impulse, p.total_normal_impulse, p.max_normal_impulse].map(f32::to_bits)
@@ -2185,7 +2241,7 @@ mod tests {
         let (mut free_h, mut free_w, mut free_cold) = (before.0, before.1, cold);
         free_cold.kinetic_energy[1] = 1e6;
         let fresh: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
-        restitution(&mut free_h, &mut free_w, &dv, &free_cold, &fresh);
+        lane_call!(restitution(&mut free_h, &mut free_w, &dv, &free_cold, &fresh));
         let lam = before.0.points[0].normal_impulse[1];
         let (capped, free) = (
             h.points[0].normal_impulse[1] - lam,

@@ -19,13 +19,16 @@
 //! step's joints ([`joint_solver`], solved one at a time first in each pass) and contacts
 //! ([`contact_set`], coloured and wide).
 
-pub(crate) mod contact_set;
+pub(crate) mod candidates;
 pub(crate) mod contact_solver;
-pub(crate) mod contact_wide;
 pub(crate) mod joint_solver;
+pub(crate) mod lanes4;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod lanes8;
 pub(crate) mod softness;
 pub(crate) use crate::math::wide;
 
+use crate::collision::contact::Contact;
 use crate::math::{Rot, Vec2};
 use crate::world::{Profile, Stopwatch};
 pub(crate) use softness::Softness;
@@ -783,13 +786,14 @@ pub(crate) trait ConstraintSet {
     }
 }
 
-/// The constraints of a step: joints, then contacts, in every pass.
-pub(crate) struct StepConstraints<'a> {
+/// The constraints of a step: joints, then contacts (of either build of the wide solver),
+/// in every pass.
+pub(crate) struct StepConstraints<'a, C> {
     pub joints: &'a mut joint_solver::JointSolver,
-    pub contacts: &'a mut contact_set::ContactSolver,
+    pub contacts: &'a mut C,
 }
 
-impl ConstraintSet for StepConstraints<'_> {
+impl<K: ConstraintSet> ConstraintSet for StepConstraints<'_, K> {
     fn has_new_contacts(&self) -> bool {
         self.contacts.has_new_contacts()
     }
@@ -820,6 +824,87 @@ impl ConstraintSet for StepConstraints<'_> {
         // The team solves colours only; joints run on one thread before each pass's
         // colours, which the per-colour path does.
         self.joints.constraints.is_empty() && self.contacts.substeps_team(ctx, sims, states, times)
+    }
+}
+
+/// The step's contact constraints in one build of the wide solver ([`lanes4`] or
+/// [`lanes8`]): what the world does with them besides the passes of [`ConstraintSet`].
+pub(crate) trait WideContacts: ConstraintSet {
+    /// Builds the step's constraints from `candidates` (see `ContactSolver::build`); `up`
+    /// is the unit vector against gravity (zero without).
+    fn build_step<S: StateRead + Sync>(
+        &mut self,
+        ctx: &StepContext,
+        states: &[S],
+        sims: &[BodySim],
+        candidates: candidates::Candidates<'_>,
+        loaded: bool,
+        up: Vec2,
+    );
+    /// Stores the step's impulses and friction states into `contacts` (see
+    /// `ContactSolver::store`).
+    fn store_step<S: StateRead + Sync>(&mut self, ctx: &StepContext, states: &[S], contacts: &mut [Option<Contact>]);
+}
+
+/// The contact constraints of the world, in the build of the wide solver it runs: eight
+/// lanes ([`lanes8`], AVX2) on an x86-64 CPU that has AVX2 unless the world asks for four
+/// ([`crate::SolverLanes`]), else four ([`lanes4`], SSE2 on x86-64). The two give the same
+/// results to the bit (every lane computes the same expressions; see
+/// [`crate::solver_lanes`]).
+pub(crate) enum Contacts {
+    Four(lanes4::contact_set::ContactSolver),
+    #[cfg(target_arch = "x86_64")]
+    Eight(lanes8::contact_set::ContactSolver),
+}
+
+impl Default for Contacts {
+    fn default() -> Contacts {
+        Contacts::Four(Default::default())
+    }
+}
+
+/// `$body` with `$s` the world's contact solver of either build (`$c`: a [`Contacts`]).
+macro_rules! with_contacts {
+    ($c:expr, $s:ident => $body:expr) => {
+        match $c {
+            $crate::solver::Contacts::Four($s) => $body,
+            #[cfg(target_arch = "x86_64")]
+            $crate::solver::Contacts::Eight($s) => $body,
+        }
+    };
+}
+pub(crate) use with_contacts;
+
+impl Contacts {
+    /// The solver a world with `lanes` takes on this CPU.
+    pub fn new(lanes: crate::SolverLanes) -> Contacts {
+        #[cfg(target_arch = "x86_64")]
+        if lanes == crate::SolverLanes::Auto && std::is_x86_feature_detected!("avx2") {
+            // The only place an eight-lane solver is made: its passes are compiled for AVX2
+            // (see `lanes8`).
+            return Contacts::Eight(Default::default());
+        }
+        let _ = lanes;
+        Contacts::Four(Default::default())
+    }
+
+    /// Constraints per wide group: 4 or 8.
+    pub fn lanes(&self) -> usize {
+        match self {
+            Contacts::Four(_) => lanes4::wide::LANES,
+            #[cfg(target_arch = "x86_64")]
+            Contacts::Eight(_) => lanes8::wide::LANES,
+        }
+    }
+
+    /// The number of layouts made so far (`ContactSolver::layouts`).
+    pub fn layouts(&self) -> u64 {
+        with_contacts!(self, s => s.layouts)
+    }
+
+    /// The contacts in solved order (`ContactSolver::solved_order`).
+    pub fn solved_order(&self, out: &mut Vec<u32>) -> usize {
+        with_contacts!(self, s => s.solved_order(out))
     }
 }
 

@@ -28,7 +28,8 @@ use crate::dynamics::{BodyDef, BodyType, Filter, Material, ShapeDef};
 use crate::error::{check_finite, check_non_negative, check_positive, check_vec, Error, Result};
 use crate::geometry::{Shape, LINEAR_SLOP, SPECULATIVE_DISTANCE};
 use crate::math::{Aabb, Transform, Vec2};
-use crate::solver::contact_set::{Candidate, ColourKey, ContactSolver};
+use crate::solver::candidates::{Candidate, ColourKey};
+use crate::solver::Contacts;
 use crate::solver::{BodySim, BodyState};
 use step::ChunkOutcomes;
 
@@ -66,6 +67,23 @@ pub struct WorldDef {
     /// affect each other (constraints of one graph colour share no moving body) and
     /// gathered back in a fixed order.
     pub workers: u32,
+    /// How many contact constraints the wide solver handles at once. Default
+    /// [`SolverLanes::Auto`]: eight (AVX2) on an x86-64 CPU that has AVX2, else four. Results
+    /// are bit-identical either way ([`crate::solver_lanes`]); only the speed differs.
+    pub solver_lanes: SolverLanes,
+}
+
+/// Which build of the wide contact solver a world runs ([`WorldDef::solver_lanes`]). The
+/// solver is compiled both ways into every x86-64 binary; the world picks one when it is
+/// made (or given new settings).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum SolverLanes {
+    /// Eight lanes (AVX2) if the CPU has AVX2, else four: the fastest this CPU runs. The
+    /// default.
+    #[default]
+    Auto,
+    /// Four lanes (SSE2 on x86-64, the baseline every x86-64 CPU has), e.g. to compare.
+    Four,
 }
 
 impl Default for WorldDef {
@@ -82,6 +100,7 @@ impl Default for WorldDef {
             time_to_sleep: 0.5,
             warm_starting: true,
             workers: 1,
+            solver_lanes: SolverLanes::Auto,
         }
     }
 }
@@ -190,7 +209,7 @@ pub struct World {
     // Scratch buffers reused every step (no per-step allocation once warm).
     pub(crate) states: Vec<BodyState>,
     pub(crate) sims: Vec<BodySim>,
-    pub(crate) contact_solver: ContactSolver,
+    pub(crate) contact_solver: Contacts,
     pub(crate) joint_solver: crate::solver::joint_solver::JointSolver,
     /// The solver's input of each contact slot, written by the narrow phase for the
     /// touching contacts with an awake dynamic side (`solver_contacts` lists them).
@@ -311,7 +330,7 @@ impl World {
             non_finite: Vec::new(),
             states: Vec::new(),
             sims: Vec::new(),
-            contact_solver: ContactSolver::default(),
+            contact_solver: Contacts::new(def.solver_lanes),
             joint_solver: Default::default(),
             candidates: Vec::new(),
             colour_keys: Vec::new(),
@@ -347,6 +366,12 @@ impl World {
         })
     }
 
+    /// Contact constraints the wide solver handles at once in this world: 8 or 4 (see
+    /// [`WorldDef::solver_lanes`]).
+    pub fn solver_lanes(&self) -> usize {
+        self.contact_solver.lanes()
+    }
+
     /// Per-stage wall-clock times of the last step.
     pub fn profile(&self) -> Profile {
         self.profile
@@ -362,6 +387,11 @@ impl World {
         def.validate()?;
         if def.workers != self.def.workers {
             self.pool = make_pool(def.workers)?;
+        }
+        if def.solver_lanes != self.def.solver_lanes {
+            // Each contact keeps its colour, which the new solver tries first.
+            self.contact_solver = Contacts::new(def.solver_lanes);
+            self.order_checked = None;
         }
         self.def = def;
         Ok(())
@@ -1153,7 +1183,7 @@ impl World {
         {
             return;
         }
-        let layout = self.contact_solver.layouts;
+        let layout = self.contact_solver.layouts();
         if self.order_checked == Some(layout) {
             return; // the same order as when it was last found good enough
         }
@@ -1389,6 +1419,7 @@ fn validate_geometry(g: &Shape) -> Result<()> {
 mod tests {
     use super::*;
     use crate::geometry::Polygon;
+    use crate::solver::with_contacts;
 
     fn square() -> Shape {
         Shape::Polygon(Polygon::new_box(0.1, 0.1).unwrap())
@@ -1583,14 +1614,17 @@ mod tests {
         let (mut a, mut b) = (pyramid(20), pyramid(20));
         for _ in 0..steps {
             a.step(1.0 / 60.0).unwrap();
-            b.contact_solver.layout_kept = false; // b colours every step afresh
+            // b colours every step afresh
+            with_contacts!(&mut b.contact_solver, s => s.layout_kept = false);
             b.step(1.0 / 60.0).unwrap();
         }
-        assert_eq!(b.contact_solver.kept_layouts, 0);
+        let kept_layouts = |w: &World| with_contacts!(&w.contact_solver, s => s.kept_layouts);
+        assert_eq!(kept_layouts(&b), 0);
         // The loads moved some constraints in or out of the front of their colours, so the
         // two worlds solve them in different orders inside a colour.
-        assert_ne!(a.contact_solver.lane_candidates, b.contact_solver.lane_candidates);
-        let kept = a.contact_solver.kept_layouts;
+        let lanes = |w: &World| with_contacts!(&w.contact_solver, s => s.lane_candidates.concat());
+        assert_ne!(lanes(&a), lanes(&b));
+        let kept = kept_layouts(&a);
         assert!(kept >= steps - 10, "layout kept in {kept} of {steps} steps");
         for ((_, x), (_, y)) in a.bodies.iter().zip(b.bodies.iter()) {
             assert_eq!((x.xf, x.v, x.w), (y.xf, y.v, y.w));

@@ -15,7 +15,8 @@ use crate::dynamics::{mix, BodyType};
 use crate::error::{Error, Result};
 use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
-use crate::solver::contact_set::{Candidate, Candidates, ColourKey};
+use crate::solver::candidates::{Candidate, Candidates, ColourKey};
+use crate::solver::WideContacts;
 use crate::solver::{
     claim_each, for_each_chunk_mut4, for_each_mut, loads, solve_step, BodySim, BodyState, SharedState, SolverBody,
     StepConstraints, StepContext,
@@ -847,18 +848,30 @@ impl World {
     /// solver stages and stores impulses back into the contacts. `bodies_ms`: the time
     /// [`World::prepare_bodies`] took (part of the solver set-up).
     fn solve(&mut self, ctx: &StepContext, bodies_ms: f32) {
+        let mut contacts = core::mem::take(&mut self.contact_solver);
+        crate::solver::with_contacts!(&mut contacts, solver => self.solve_with(ctx, bodies_ms, solver));
+        self.contact_solver = contacts;
+    }
+
+    /// [`World::solve`] with the world's build of the wide solver.
+    fn solve_with<C: WideContacts>(&mut self, ctx: &StepContext, bodies_ms: f32, solver: &mut C) {
         let mut lap = Stopwatch::start();
         let g = self.def.gravity;
-        let mut solver = core::mem::take(&mut self.contact_solver);
-        solver.up = (-g).normalize_or_zero();
         let candidates = Candidates::new(&self.candidates, &self.colour_keys, &self.solver_contacts);
-        solver.build(ctx, &self.states, &self.sims, candidates, self.any_load);
+        solver.build_step(
+            ctx,
+            &self.states,
+            &self.sims,
+            candidates,
+            self.any_load,
+            (-g).normalize_or_zero(),
+        );
         self.build_joints(ctx);
         self.profile.solver_setup = bodies_ms + lap.lap();
         let mut joints = core::mem::take(&mut self.joint_solver);
         let mut set = StepConstraints {
             joints: &mut joints,
-            contacts: &mut solver,
+            contacts: solver,
         };
         if ctx.parallel {
             // Threads share the states in place (`SharedState`, 32 bytes each).
@@ -869,8 +882,7 @@ impl World {
             solve_step(ctx, &self.sims, cells, &mut set, &mut self.profile);
         }
         lap.lap();
-        solver.store(ctx, &self.states, &mut self.contacts);
-        self.contact_solver = solver;
+        solver.store_step(ctx, &self.states, &mut self.contacts);
         self.joint_solver = joints;
         self.store_joints(ctx);
         self.profile.store = lap.lap();
