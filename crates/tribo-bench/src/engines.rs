@@ -64,7 +64,11 @@ impl EngineKind {
 pub fn tribo_lanes() -> tribo::SolverLanes {
     match std::env::var("TRIBO_BENCH_LANES").as_deref() {
         Ok("4") => tribo::SolverLanes::Four,
-        _ => tribo::SolverLanes::Auto,
+        Ok("") | Ok("auto") | Err(_) => tribo::SolverLanes::Auto,
+        Ok(other) => {
+            eprintln!("TRIBO_BENCH_LANES={other:?}: not 4 or auto; taking auto");
+            tribo::SolverLanes::Auto
+        }
     }
 }
 

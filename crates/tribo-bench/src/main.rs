@@ -279,8 +279,8 @@ fn print_header(args: &Args) {
     println!("tribo-bench: CPU {cpu}, {cores} cores available");
     match engines::tribo_lanes() {
         tribo::SolverLanes::Four => println!(
-            "Tribo {} (solver: 4 lanes, TRIBO_BENCH_LANES=4)",
-            env!("CARGO_PKG_VERSION")
+            "Tribo {} on this CPU; here worlds with SolverLanes::Four: 4 lanes (TRIBO_BENCH_LANES=4)",
+            tribo::build_info()
         ),
         _ => println!("Tribo {}", tribo::build_info()),
     }

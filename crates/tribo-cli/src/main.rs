@@ -234,14 +234,15 @@ fn run(args: &RunArgs) -> Result<(), String> {
         0.0
     };
     eprintln!(
-        "{}: {} steps of {:.4} s, {} bodies, {} contacts at the end, {:.3} ms/step ({:.2} s)",
+        "{}: {} steps of {:.4} s, {} bodies, {} contacts at the end, {:.3} ms/step ({:.2} s; solver: {} lanes)",
         args.scene,
         scene.steps,
         scene.dt,
         sim.built.world.body_count(),
         sim.built.world.contacts().count(),
         per_step,
-        elapsed
+        elapsed,
+        sim.built.world.solver_lanes()
     );
     Ok(())
 }

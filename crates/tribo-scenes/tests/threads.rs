@@ -1,25 +1,18 @@
-//! Determinism across thread counts: a step split between worker threads must give
-//! bit-identical results to the single-threaded step (WorldDef::workers' promise). The
-//! scenes mix resting stacks (many graph colours, new contacts estimated on the first
-//! step), sliding, rolling, bouncing and a kinematic body, so every parallel stage runs.
+//! Determinism across thread counts and solver widths: a step split between worker threads
+//! must give bit-identical results to the single-threaded step (WorldDef::workers'
+//! promise), and the wide solver's eight-lane build (AVX2, what `SolverLanes::Auto` takes
+//! on a CPU with AVX2) the same results as its four-lane one (WorldDef::solver_lanes'
+//! promise). The scenes mix resting stacks (many graph colours, new contacts estimated on
+//! the first step), sliding, rolling, bouncing and a kinematic body, so every parallel
+//! stage runs.
 
-use tribo::{World, WorldDef};
-use tribo_scenes::scenes;
+use tribo::{SolverLanes, World, WorldDef};
+use tribo_scenes::scenes::{self, SCENES};
 
-/// Every body's pose and velocity, as raw bits, after `steps` steps with `workers` threads.
-fn run(build: fn() -> tribo_scenes::format::SceneFile, workers: u32, steps: u32) -> Vec<u32> {
-    let built = build().build().expect("scene builds");
-    let mut world: World = built.world;
-    let def = WorldDef {
-        workers,
-        ..*world.def()
-    };
-    world.set_def(def).expect("workers accepted");
-    for _ in 0..steps {
-        world.step(built.dt).expect("step");
-    }
+/// Every body's pose and velocity, as raw bits.
+fn state_bits(world: &World, bodies: &[tribo::BodyId]) -> Vec<u32> {
     let mut bits = Vec::new();
-    for &id in &built.bodies {
+    for &id in bodies {
         let p = world.body_position(id).unwrap();
         let v = world.body_linear_velocity(id).unwrap();
         bits.extend(
@@ -37,6 +30,39 @@ fn run(build: fn() -> tribo_scenes::format::SceneFile, workers: u32, steps: u32)
     bits
 }
 
+/// The world's settings with `workers` threads and `lanes`.
+fn with(world: &mut World, workers: u32, lanes: SolverLanes) {
+    let def = WorldDef {
+        workers,
+        solver_lanes: lanes,
+        ..*world.def()
+    };
+    world.set_def(def).expect("settings accepted");
+}
+
+/// [`state_bits`] after `steps` steps with `workers` threads and `lanes` (the scene's step
+/// hook not run: `.ci/run` compares hooked scenes through the CLI), and the world's lane
+/// count.
+fn run_with(
+    build: fn() -> tribo_scenes::format::SceneFile,
+    workers: u32,
+    lanes: SolverLanes,
+    steps: u32,
+) -> (Vec<u32>, usize) {
+    let built = build().build().expect("scene builds");
+    let mut world: World = built.world;
+    with(&mut world, workers, lanes);
+    for _ in 0..steps {
+        world.step(built.dt).expect("step");
+    }
+    (state_bits(&world, &built.bodies), world.solver_lanes())
+}
+
+/// [`state_bits`] after `steps` steps with `workers` threads.
+fn run(build: fn() -> tribo_scenes::format::SceneFile, workers: u32, steps: u32) -> Vec<u32> {
+    run_with(build, workers, SolverLanes::Auto, steps).0
+}
+
 #[test]
 fn two_and_three_workers_match_one_bit_for_bit() {
     // (scene, steps): long enough for contacts to begin, end, slide and sleep.
@@ -49,11 +75,13 @@ fn two_and_three_workers_match_one_bit_for_bit() {
     ];
     for (build, steps) in cases {
         let one = run(build, 1, steps);
-        for workers in [2, 3] {
-            let many = run(build, workers, steps);
+        for (workers, lanes) in [(2, SolverLanes::Auto), (3, SolverLanes::Auto), (2, SolverLanes::Four)] {
+            // (Four lanes on two threads: on a CPU with AVX2 the default runs eight, and
+            // the four-lane build's team loop would go untested.)
+            let (many, _) = run_with(build, workers, lanes, steps);
             assert!(
                 one == many,
-                "{workers} workers differ from 1 worker in {} of {} values",
+                "{workers} workers ({lanes:?} lanes) differ from 1 worker in {} of {} values",
                 one.iter().zip(&many).filter(|(a, b)| a != b).count(),
                 one.len()
             );
@@ -82,4 +110,78 @@ fn workers_out_of_range_are_rejected_and_change_nothing() {
         ..WorldDef::default()
     })
     .is_err());
+}
+
+/// Eight lanes and four step every library scene to the same bits: every lane computes the
+/// same expressions whatever the width (no tolerance: the promise is identity, and any
+/// reordering of a sum would show in the last bit within a few steps of a pile). On a CPU
+/// without AVX2 both worlds run four lanes and the test says so (it then cannot fail on the
+/// width). Checked by mutation: with the eight-lane subtraction made an addition it fails
+/// on the first scene.
+#[test]
+fn eight_and_four_lanes_step_every_scene_to_the_same_bits() {
+    let auto = tribo::solver_lanes();
+    // `Auto` takes eight lanes exactly where the CPU has AVX2.
+    #[cfg(target_arch = "x86_64")]
+    assert_eq!(auto == 8, std::is_x86_feature_detected!("avx2"), "lanes taken: {auto}");
+    if auto == 4 {
+        eprintln!("this CPU has no AVX2: both worlds run four lanes");
+    }
+    for entry in SCENES {
+        // Long enough for piles to settle (new contacts estimated, friction states
+        // switching) and for the dynamic scenes to collide; the largest scenes fewer steps
+        // (each costs milliseconds).
+        let steps = if entry.name.starts_with("scaling_rain") || entry.name == "many_pyramids" {
+            40
+        } else {
+            120
+        };
+        let (wide, lanes_auto) = run_with(entry.build, 1, SolverLanes::Auto, steps);
+        let (four, lanes_four) = run_with(entry.build, 1, SolverLanes::Four, steps);
+        assert_eq!(
+            (lanes_auto, lanes_four),
+            (auto, 4),
+            "{}: the worlds' lane counts",
+            entry.name
+        );
+        // The scene really moved (else the comparison would prove nothing), but for one
+        // whose bodies all come from its step hook (rain's, which `.ci/run` compares
+        // through the CLI).
+        let (start, _) = run_with(entry.build, 1, SolverLanes::Four, 0);
+        assert!(
+            start != four || entry.hook.is_some(),
+            "{}: nothing moved in {steps} steps",
+            entry.name
+        );
+        let differ = wide.iter().zip(&four).filter(|(a, b)| a != b).count();
+        assert!(
+            differ == 0 && wide.len() == four.len(),
+            "{}: {auto} lanes and 4 lanes differ in {differ} of {} values after {steps} steps",
+            entry.name,
+            wide.len()
+        );
+    }
+}
+
+/// Changing `WorldDef::solver_lanes` mid-run (a new solver; the contacts keep their colours)
+/// changes no result either: the tumbler (its turning drum keeps every box awake and
+/// moving) stepped with eight lanes, then four, then eight again (on two threads in the
+/// middle) ends where one stepped with four throughout ends.
+#[test]
+fn switching_lanes_mid_run_changes_no_result() {
+    let (steady, _) = run_with(scenes::tumbler, 1, SolverLanes::Four, 90);
+    let built = scenes::tumbler().build().expect("scene builds");
+    let mut world = built.world;
+    for (workers, lanes) in [(1, SolverLanes::Auto), (2, SolverLanes::Four), (1, SolverLanes::Auto)] {
+        with(&mut world, workers, lanes);
+        let before = state_bits(&world, &built.bodies);
+        for _ in 0..30 {
+            world.step(built.dt).expect("step");
+        }
+        assert_ne!(before, state_bits(&world, &built.bodies), "the tumbler stood still");
+    }
+    assert!(
+        state_bits(&world, &built.bodies) == steady,
+        "switching lanes changed the tumbler's state"
+    );
 }

@@ -1,6 +1,6 @@
-//! Four-lane floats: the wide contact solver's lanes in the default build (eight-lane ones
-//! in a build for AVX2: `wide8`, through [`FL`]), and the few four-wide steps of manifold
-//! recycling and polygon collision.
+//! Four-lane floats: the lanes of the wide contact solver's four-lane build
+//! (`solver::lanes4`; its eight-lane build takes `wide8`'s), and the few four-wide steps of
+//! manifold recycling and polygon collision.
 //!
 //! `F4` is four `f32` lanes; every operation is lane-wise plain IEEE arithmetic (no fused
 //! multiply-add, no approximate reciprocal), so a lane computes bit for bit what the same

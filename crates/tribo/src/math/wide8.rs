@@ -10,7 +10,7 @@
 //! inlined there (out of line, each intrinsic would be a call).
 
 use super::wide::F4;
-use core::arch::x86_64::{__m128, __m256, __m256i};
+use core::arch::x86_64::{__m256, __m256i};
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub, SubAssign};
 
 /// Lanes of [`F8`].
@@ -43,7 +43,8 @@ mod avx {
                 // SAFETY: the CPU has AVX and AVX2 wherever an eight-lane value exists:
                 // they are made and used only in `solver::lanes8`, whose solver the world
                 // takes only after `is_x86_feature_detected!("avx2")` (`solver::Contacts`),
-                // or in a crate compiled for AVX2 as a whole. These intrinsics work on
+                // or in a crate compiled for AVX2 as a whole, or in this module's tests,
+                // which return first on a CPU without it. These intrinsics work on
                 // values only: they read and write no memory.
                 unsafe { core::arch::x86_64::$name$(::<$c>)?($($a),*) }
             }
@@ -218,24 +219,33 @@ impl F8 {
 /// does (eight shuffles for the eight rows, as for four rows with four lanes).
 #[inline(always)]
 pub(crate) fn rows_to_lanes8(rows: [F4; LANES8]) -> [F8; 4] {
-    let r = |k: usize| -> __m128 { crate::math::wide::sse_register(rows[k]) };
-    let v: [__m256; 4] = core::array::from_fn(|i| _mm256_set_m128(r(i + 4), r(i)));
-    transpose_halves(v).map(F8)
+    use crate::math::wide::sse_register as sse;
+    // Spelled out, without closures or `array::from_fn` / `map`: this is inlined into code
+    // compiled for AVX2, and a closure here would not be (`wide::array_of`).
+    let [t0, t1, t2, t3] = transpose_halves([
+        _mm256_set_m128(sse(rows[4]), sse(rows[0])),
+        _mm256_set_m128(sse(rows[5]), sse(rows[1])),
+        _mm256_set_m128(sse(rows[6]), sse(rows[2])),
+        _mm256_set_m128(sse(rows[7]), sse(rows[3])),
+    ]);
+    [F8(t0), F8(t1), F8(t2), F8(t3)]
 }
 
 /// The inverse of [`rows_to_lanes8`]: four vectors of eight lanes as eight 16-byte rows.
 #[inline(always)]
 pub(crate) fn lanes_to_rows8(cols: [F8; 4]) -> [F4; LANES8] {
-    let t = transpose_halves(cols.map(|c| c.0));
-    let half = |i: usize| -> F4 {
-        let v = t[i % 4];
-        crate::math::wide::from_sse_register(if i < 4 {
-            _mm256_castps256_ps128(v)
-        } else {
-            _mm256_extractf128_ps::<1>(v)
-        })
-    };
-    core::array::from_fn(half)
+    use crate::math::wide::from_sse_register as f4;
+    let [t0, t1, t2, t3] = transpose_halves([cols[0].0, cols[1].0, cols[2].0, cols[3].0]);
+    [
+        f4(_mm256_castps256_ps128(t0)),
+        f4(_mm256_castps256_ps128(t1)),
+        f4(_mm256_castps256_ps128(t2)),
+        f4(_mm256_castps256_ps128(t3)),
+        f4(_mm256_extractf128_ps::<1>(t0)),
+        f4(_mm256_extractf128_ps::<1>(t1)),
+        f4(_mm256_extractf128_ps::<1>(t2)),
+        f4(_mm256_extractf128_ps::<1>(t3)),
+    ]
 }
 
 /// The 4×4 transpose of each 128-bit half of four registers.
@@ -426,6 +436,16 @@ crate::math::wide::lane_vectors!(V8, F8, "Eight 2D vectors, one per lane.");
 mod tests {
     use super::*;
 
+    /// Whether this CPU can run the eight-lane operations: the tests return at once on one
+    /// that cannot (the library never runs them there; `solver::Contacts`).
+    fn avx2() -> bool {
+        let yes = std::is_x86_feature_detected!("avx2");
+        if !yes {
+            eprintln!("no AVX2 on this CPU: eight-lane operations not tested");
+        }
+        yes
+    }
+
     fn f8(f: impl Fn(usize) -> f32) -> F8 {
         F8::new(core::array::from_fn(f))
     }
@@ -434,6 +454,9 @@ mod tests {
     /// zeros included (the same rules as the four-lane operations).
     #[test]
     fn eight_lanes_match_scalar_arithmetic() {
+        if !avx2() {
+            return;
+        }
         let xs = [1.5, -2.0, 0.0, 3.25, f32::NAN, -0.0, 1e-30, 7.0];
         let ys = [0.5, 4.0, -0.0, -1.0, 1.0, 0.0, f32::NAN, 7.0];
         let (a, b) = (F8::new(xs), F8::new(ys));
@@ -467,6 +490,9 @@ mod tests {
     /// Masks from stored booleans, bytes and words set exactly their own lanes.
     #[test]
     fn eight_lane_masks_set_exactly_their_lanes() {
+        if !avx2() {
+            return;
+        }
         for l in 0..LANES8 {
             for x in [1u8, 2, 0x80, 0xFF] {
                 let mut bytes = [0u8; LANES8];
@@ -493,6 +519,9 @@ mod tests {
     /// Rows to lanes and back: lane `l` of vector `i` is element `i` of row `l`.
     #[test]
     fn rows_and_lanes_are_transposes() {
+        if !avx2() {
+            return;
+        }
         let rows: [F4; LANES8] = core::array::from_fn(|l| F4::new(core::array::from_fn(|i| (10 * l + i) as f32)));
         let cols = rows_to_lanes8(rows);
         for (i, c) in cols.iter().enumerate() {

@@ -82,7 +82,7 @@ impl Candidate {
 pub(crate) struct ColourKey {
     pub(crate) index_a: u32,
     pub(crate) index_b: u32,
-    /// The colour the contact had when last solved ([`NO_COLOUR`]: none), tried first.
+    /// The colour the contact had when last solved ([`crate::collision::contact::NO_COLOUR`]: none), tried first.
     pub(crate) colour: u8,
     /// [`FAST`], [`FRESH`], [`KEY_DYNAMIC_A`], [`KEY_DYNAMIC_B`], [`KEY_RATIO`].
     pub(crate) flags: u8,

@@ -96,6 +96,8 @@ pub(crate) struct ContactSolver {
     ranges: Vec<(u32, u32)>,
     /// Per entry of `ranges`: the colour's first group of constraints not taken to its
     /// front by [`fast_first`] (a group holding both kinds counts with the front).
+    ///
+    /// [`fast_first`]: crate::solver::candidates::fast_first
     slow_start: Vec<u32>,
     /// Per entry of `ranges`: the colour's first group of [`SINGLE`] constraints, its back
     /// part (a group holding both kinds counts with the part before).
@@ -647,6 +649,8 @@ impl ContactSolver {
 
     /// A candidate between a light body and one more than [`MASS_RATIO_GROUP`] times
     /// heavier that rests on it: (light body state, its sweeps).
+    ///
+    /// [`MASS_RATIO_GROUP`]: crate::solver::contact_solver::MASS_RATIO_GROUP
     #[super::lane_fn]
     fn light_body(&self, cand: &Candidate, sims: &[BodySim]) -> Option<(u32, u32)> {
         // Only where the heavy body rests on the light one: it lies above it against
@@ -716,6 +720,8 @@ impl ContactSolver {
     /// through a light body between a heavy one and the ground only at a rate of about m/M
     /// per sweep, so a 100:1 stack needs ~100 sweeps where one is enough for equal masses.
     /// Only when some body is loaded ([`crate::solver::any_load`]).
+    ///
+    /// [`MASS_RATIO_GROUP`]: crate::solver::contact_solver::MASS_RATIO_GROUP
     #[super::lane_fn]
     fn build_groups(&mut self, mut light: Vec<(u32, u32)>, candidates: Candidates<'_>) {
         if light.is_empty() {
@@ -1183,6 +1189,8 @@ impl ContactSolver {
     /// worse, never wrong: every block is still solved once per pass.
     /// [`ContactSolver::team_blocks`]' group boundaries: per colour, per part, the groups
     /// where each thread's share starts, then the part's end.
+    ///
+    /// [`fast_first`]: crate::solver::candidates::fast_first
     #[super::lane_fn]
     fn team_cuts(&self, threads: usize, per_thread: usize) -> TeamCuts {
         let owner_key = |h: &WideHead| {

@@ -1,8 +1,8 @@
 //! The wide contact solver: graph colouring and four contacts per SIMD lane group (eight
-//! in a build for AVX2: [`LANES`]; "four" below reads as `LANES`, and the byte counts as
-//! those of four lanes).
+//! in the build for AVX2, `solver::lanes8`: [`LANES`]; "four" below reads as `LANES`, and
+//! the byte counts as those of four lanes).
 //!
-//! The physics is exactly the scalar contact constraint's ([`super::contact_solver`]: soft
+//! The physics is exactly the scalar contact constraint's ([`crate::solver::contact_solver`]: soft
 //! normal rows with preload, 2×2 block solve, patch friction with stick/slip and the drift
 //! anchor, rolling resistance); this module only changes the order and the layout:
 //!
@@ -610,6 +610,21 @@ fn kinetic_part(inv_m: FL, inv_i: FL, s: &WideBody) -> FL {
     lin + ang
 }
 
+/// A point's sequential normal row (`contact_solver::normal_row`): from impulse `lam`, with
+/// normal mass `mass`, right-hand side `rhs` and its softness (`ms`, `is`, preload `pre`),
+/// clamped at zero. (Functions, not closures: see [`point_impulse`].)
+#[inline(always)]
+fn sequential_row(lam: FL, mass: FL, ms: FL, rhs: FL, is: FL, pre: FL) -> FL {
+    (lam + (-(mass * ms * rhs) - is * (lam - pre))).max(FL::ZERO)
+}
+
+/// A point's impulse in the 2×2 block (`contact_solver::solve_block`'s soft form): from
+/// impulse `lam` and the block's rigid solution's change `rd`.
+#[inline(always)]
+fn soft_row(lam: FL, ms: FL, is: FL, pre: FL, rd: FL) -> FL {
+    lam + ms * rd - is * (lam - pre)
+}
+
 /// The normal rows of one pass over four constraints (contact_solver::normal_row): bias
 /// and softness per point, then the 2×2 block or the points in turn; returns the points'
 /// new impulses. `POINTS` = 1 for a group with no second point in any lane (see
@@ -661,24 +676,18 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
     let (lam0, lam1) = (h.points[0].normal_impulse, h.points[1].normal_impulse);
     let (pre0, pre1) = (p0.preload, p1.preload);
     let rhs0 = vn[0] + bias[0];
-    // A point's sequential row (contact_solver::normal_row): from impulse `lam`, with
-    // normal mass `mass`, right-hand side `rhs` and its softness, clamped at zero.
-    let seq =
-        |lam: FL, mass: FL, ms: FL, rhs: FL, is: FL, pre: FL| (lam + (-(mass * ms * rhs) - is * (lam - pre))).max(zero);
     let (new0, new1) = if POINTS == 1 {
         // The sequential row of the first point (the general path's `seq0`).
-        let seq0 = seq(lam0, p0.normal_mass, ms[0], rhs0, is[0], pre0);
+        let seq0 = sequential_row(lam0, p0.normal_mass, ms[0], rhs0, is[0], pre0);
         apply_row(h, a, b, n, rn[0], seq0 - lam0);
         (seq0, zero)
     } else {
         // The 2×2 block LCP (contact_solver::solve_block), all four cases in every lane.
         let rhs1 = vn[1] + bias[1];
-        let soft0 = |rd: FL| lam0 + ms[0] * rd - is[0] * (lam0 - pre0);
-        let soft1 = |rd: FL| lam1 + ms[1] * rd - is[1] * (lam1 - pre1);
         // K⁻¹ (zero where the block does not apply).
         let (i11, i12, i22) = (dv.i11, dv.i12, dv.i22);
-        let xa0 = soft0(-(i11 * rhs0 + i12 * rhs1));
-        let xa1 = soft1(-(i12 * rhs0 + i22 * rhs1));
+        let xa0 = soft_row(lam0, ms[0], is[0], pre0, -(i11 * rhs0 + i12 * rhs1));
+        let xa1 = soft_row(lam1, ms[1], is[1], pre1, -(i12 * rhs0 + i22 * rhs1));
         let ok_a = xa0.ge(zero) & xa1.ge(zero);
         if (ok_a & c.block).all() {
             // Common case (a resting face): both points active in every lane.
@@ -688,11 +697,11 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
         } else {
             let r0 = rhs0 - c.k12 * lam1;
             // 1/k11 and 1/k22: the points' normal masses (where the block applies).
-            let xb0 = soft0(-(r0 * p0.normal_mass));
+            let xb0 = soft_row(lam0, ms[0], is[0], pre0, -(r0 * p0.normal_mass));
             let wb1 = rhs1 + c.k12 * (xb0 - lam0) - c.k22 * lam1;
             let ok_b = xb0.ge(zero) & wb1.ge(zero);
             let r1 = rhs1 - c.k12 * lam0;
-            let xc1 = soft1(-(r1 * p1.normal_mass));
+            let xc1 = soft_row(lam1, ms[1], is[1], pre1, -(r1 * p1.normal_mass));
             let wc0 = rhs0 + c.k12 * (xc1 - lam1) - c.k11 * lam0;
             let ok_c = xc1.ge(zero) & wc0.ge(zero);
             let wd0 = rhs0 - c.k11 * lam0 - c.k12 * lam1;
@@ -708,11 +717,11 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
                 (block0, block1)
             } else {
                 // Sequential rows where the block solve does not apply.
-                let seq0 = seq(lam0, p0.normal_mass, ms[0], rhs0, is[0], pre0);
+                let seq0 = sequential_row(lam0, p0.normal_mass, ms[0], rhs0, is[0], pre0);
                 let new0 = found.select(block0, seq0);
                 apply_row(h, a, b, n, rn[0], new0 - lam0);
                 let vn1 = row_speed(a, b, n, rn[1]);
-                let seq1 = seq(lam1, p1.normal_mass, ms[1], vn1 + bias[1], is[1], pre1);
+                let seq1 = sequential_row(lam1, p1.normal_mass, ms[1], vn1 + bias[1], is[1], pre1);
                 let new1 = found.select(block1, seq1);
                 apply_row(h, a, b, n, rn[1], new1 - lam1);
                 (new0, new1)
@@ -2064,7 +2073,7 @@ mod tests {
     /// beside a two-point face with rolling resistance ends with the same impulses and the
     /// same body states, to the bit (with nonzero velocities: a zero added to −0.0 gives
     /// +0.0). This is why the four- and eight-lane builds step alike
-    /// (`crate::SOLVER_LANES`): their groups hold different neighbours.
+    /// (`crate::solver_lanes`): their groups hold different neighbours.
     #[test]
     fn a_lane_gets_the_same_bits_whatever_its_neighbours() {
         let ctx = StepContext::for_tests();

@@ -54,11 +54,12 @@ pub(crate) struct BodyState {
 }
 
 /// A body's [`BodyState`] shared by the worker threads of a step: plain memory, read and
-/// written without atomics (one of the crate's seven `unsafe` sites; the others are
+/// written without atomics (one of the crate's nine `unsafe` sites; the others are
 /// [`SharedState::from_mut_slice`], [`prefetch`], the SSE intrinsics of [`wide`], the lanes
 /// of a [`wide`] register read as an array (its `Deref`), the row access of [`rows_at`]
-/// and [`write_velocity_row`], and in a build for AVX2 `math::wide8`'s intrinsics and
-/// lanes).
+/// and [`write_velocity_row`], `math::wide8`'s AVX intrinsics and lanes, and the calls into
+/// the eight-lane solver compiled for AVX2 in `contact_set`'s `ConstraintSet` and
+/// [`WideContacts`] impls).
 ///
 /// Why it is race-free — the contract every user of [`StateCell`] for `SharedState` keeps:
 /// - a constraint pass runs colour by colour, and the constraints of one colour share no

@@ -289,7 +289,7 @@ pub struct World {
     pub(crate) step_count: u64,
     /// The step count when the contacts were last renumbered ([`World::reorder_contacts`]).
     pub(crate) reordered_at: Option<u64>,
-    /// The solver layout ([`ContactSolver::layouts`]) [`World::reorder_contacts`] last
+    /// The solver layout (`ContactSolver::layouts`, through `solver::Contacts::layouts`) [`World::reorder_contacts`] last
     /// found in good enough order: a kept layout is not walked again (it was walked in
     /// every step of a resting pile, 0.7 % of large_pyramid's step).
     pub(crate) order_checked: Option<u64>,
