@@ -23,7 +23,7 @@
 //!   row per lane: the patch row at the middle of a two-point manifold, or the point row
 //!   of a one-point manifold (the same row with one point). Empty lanes of the last group
 //!   of a colour use the static body (index 0) on both sides and zero masses.
-//! * Body velocities are gathered from [`BodyState`] into lanes and scattered back; only
+//! * Body velocities are gathered from `BodyState` into lanes and scattered back; only
 //!   dynamic bodies are written (no two lanes of a colour share one).
 //!
 //! A lane computes the same expressions as the scalar code in the same order of
@@ -209,7 +209,7 @@ const _: () = assert!(core::mem::size_of::<WideDerived>() == 9 * VECTOR);
 const _: () = assert!(core::mem::size_of::<WideContact>() == 25 * VECTOR);
 const _: () = assert!(core::mem::size_of::<WideHead>() == 26 * VECTOR);
 
-/// Four bodies' velocities and step motion, gathered from [`BodyState`]s.
+/// Four bodies' velocities and step motion, gathered from `BodyState`s.
 #[derive(Clone, Copy, Debug)]
 struct WideBody {
     v: VL,

@@ -4,7 +4,8 @@
 //! Pipeline stage: after the narrow phase, before finalize. The stage order of one step:
 //!
 //! 1. prepare constraints (anchors, effective masses, softness, warm-start impulses, graph
-//!    colouring; built by the world from the touching contacts, see [`contact_set`]);
+//!    colouring; built by the world from the touching contacts, see `contact_set` in
+//!    [`lanes4`] and [`lanes8`]);
 //!    estimate the impulses of new resting contacts
 //! 2. for each of the `substeps` substeps of length `h = dt / substeps`:
 //!    1. integrate velocities (gravity, forces, damping)
@@ -17,7 +18,8 @@
 //!
 //! Constraints join the solver through [`ConstraintSet`]: [`StepConstraints`] holds the
 //! step's joints ([`joint_solver`], solved one at a time first in each pass) and contacts
-//! ([`contact_set`], coloured and wide).
+//! (`contact_set`, coloured and wide, in the build of the wide solver the world runs:
+//! [`Contacts`]).
 
 pub(crate) mod candidates;
 pub(crate) mod contact_solver;
