@@ -373,12 +373,21 @@ fn apply_row(c: &WideHead, a: &mut WideBody, b: &mut WideBody, u: VL, m: (FL, FL
 #[inline(always)]
 fn friction_arms(h: &WideHead) -> (VL, VL) {
     let [p0, p1] = &h.points;
-    let mid = |p: VL, q: VL| (p + q).scale(FL::splat(0.5));
-    let pick = |p: VL, q: VL| VL {
-        x: h.two_points.select(p.x, q.x),
-        y: h.two_points.select(p.y, q.y),
-    };
-    (pick(mid(p0.r_a, p1.r_a), p0.r_a), pick(mid(p0.r_b, p1.r_b), p0.r_b))
+    (
+        patch_anchor(h.two_points, p0.r_a, p1.r_a),
+        patch_anchor(h.two_points, p0.r_b, p1.r_b),
+    )
+}
+
+/// The middle of `p` and `q` where `two` (a two-point patch), else `p` (a function, not a
+/// closure: see [`point_impulse`]).
+#[inline(always)]
+fn patch_anchor(two: ML, p: VL, q: VL) -> VL {
+    let mid = (p + q).scale(FL::splat(0.5));
+    VL {
+        x: two.select(mid.x, p.x),
+        y: two.select(mid.y, p.y),
+    }
 }
 
 /// The share of the row's friction impulse point `i` carries (½ each of two points, all of
@@ -405,11 +414,11 @@ fn static_lanes(h: &WideHead) -> ML {
 fn lane_softness(h: &WideHead, soft: &StepSoftness) -> (FL, FL, FL) {
     let fixed = static_lanes(h);
     let (s, c) = (&soft.static_contact, &soft.contact);
-    let pick = |x: f32, y: f32| fixed.select(FL::splat(x), FL::splat(y));
+    // (Spelled out, not a closure: see `point_impulse`.)
     (
-        pick(s.bias_rate, c.bias_rate),
-        pick(s.mass_scale, c.mass_scale),
-        pick(s.impulse_scale, c.impulse_scale),
+        fixed.select(FL::splat(s.bias_rate), FL::splat(c.bias_rate)),
+        fixed.select(FL::splat(s.mass_scale), FL::splat(c.mass_scale)),
+        fixed.select(FL::splat(s.impulse_scale), FL::splat(c.impulse_scale)),
     )
 }
 
@@ -1078,8 +1087,9 @@ pub(crate) fn build_group<S: StateRead>(
 #[inline(always)]
 fn wide_shift_cap2(ma: FL, ia: FL, mb: FL, ib: FL) -> FL {
     let (zero, max) = (FL::ZERO, FL::splat(f32::MAX));
-    let side = |inv_m: FL, inv_i: FL| inv_i.gt(zero).select(inv_m / inv_i, max);
-    let rho2 = side(ma, ia).min(side(mb, ib));
+    // (Spelled out, not a closure: see `point_impulse`.)
+    let (side_a, side_b) = (ia.gt(zero).select(ma / ia, max), ib.gt(zero).select(mb / ib, max));
+    let rho2 = side_a.min(side_b);
     rho2.lt(max).select(FL::splat(0.25) * rho2, max)
 }
 
