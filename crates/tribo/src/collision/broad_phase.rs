@@ -5,6 +5,7 @@
 //! step costs O(m log n) for m moved shapes among n. Pairs live as contacts until their
 //! fat boxes stop overlapping (checked in the narrow phase).
 
+use super::sweep_prune::SweepPrune;
 use super::tree::{DynamicTree, FlatTree};
 use crate::geometry::{Shape, SPECULATIVE_DISTANCE};
 use crate::math::Aabb;
@@ -76,10 +77,16 @@ pub(crate) struct BroadPhase {
     pub moved_mark: Vec<bool>,
     /// Pair updates that walked the moving tree against itself (diagnostics and tests).
     pub walks: u64,
+    /// Sweep and prune over the moving tree's boxes (its buffers and back-off), tried
+    /// before that walk.
+    pub sweep: SweepPrune,
     /// Tests: never walk the tree, query per moved shape (the reference the walk must
     /// match).
     #[cfg(test)]
     pub no_walk: bool,
+    /// Tests: walk the tree without trying the sweep first.
+    #[cfg(test)]
+    pub no_sweep: bool,
 }
 
 /// A pair update that queries at least 1/`FLAT_QUERY_SHARE` of a tree's proxy count
@@ -90,11 +97,13 @@ impl BroadPhase {
     /// Makes the query copies of the trees current where `queries` queries pay for it (a
     /// copy that is still current, as the static tree's mostly is, is kept); returns which
     /// trees to query through their copy. Queries give the same overlaps either way.
-    pub fn prepare_queries(&mut self, queries: usize) -> [bool; 2] {
+    /// `few[k]`: tree `k` takes few queries whatever `queries` says (no copy made for it).
+    pub fn prepare_queries(&mut self, queries: usize, few: [bool; 2]) -> [bool; 2] {
         let mut use_flat = [false; 2];
         for (k, (tree, flat)) in self.trees.iter().zip(self.flat.iter_mut()).enumerate() {
             use_flat[k] = flat.is_copy_of(tree);
-            if !use_flat[k] && queries * FLAT_QUERY_SHARE >= tree.proxy_count() && tree.proxy_count() > 0 {
+            let many = queries * FLAT_QUERY_SHARE >= tree.proxy_count() && !few[k];
+            if !use_flat[k] && many && tree.proxy_count() > 0 {
                 tree.flatten_into(flat);
                 use_flat[k] = true;
             }

@@ -6,6 +6,7 @@
 
 pub(crate) mod broad_phase;
 pub(crate) mod contact;
+pub(crate) mod sweep_prune;
 pub(crate) mod tree;
 
 pub use contact::FrictionState;

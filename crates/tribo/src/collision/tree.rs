@@ -496,6 +496,15 @@ impl DynamicTree {
         }
     }
 
+    /// Calls `f(fat box, user data)` for every proxy, in node order.
+    pub fn for_each_leaf<F: FnMut(Aabb, u64)>(&self, mut f: F) {
+        for n in &self.nodes {
+            if n.is_leaf() && !n.is_free() {
+                f(n.aabb, n.user_data);
+            }
+        }
+    }
+
     /// Number of live proxies.
     #[inline]
     pub fn proxy_count(&self) -> usize {

@@ -1839,21 +1839,26 @@ mod tests {
         w
     }
 
-    /// When most moving proxies moved, the pair update walks the moving tree against
-    /// itself (`FlatTree::self_pairs`) instead of querying it once per moved shape: the
-    /// same new pairs, created in the same (sorted) order, so every contact, pose and
-    /// velocity is bit for bit that of a world that always queries.
+    /// When most moving proxies moved, the pair update finds the moving tree's pairs all
+    /// at once, by sweep and prune over its boxes (`SweepPrune`) or by a walk of the tree
+    /// against itself (`FlatTree::self_pairs`), instead of querying it once per moved
+    /// shape: the same new pairs, created in the same (sorted) order, so every contact,
+    /// pose and velocity is bit for bit that of a world that always queries.
     #[test]
-    fn walking_the_tree_finds_the_same_pairs() {
-        let (mut a, mut b) = (shower(300), shower(300));
+    fn sweeping_or_walking_the_tree_finds_the_same_pairs() {
+        let (mut a, mut b, mut c) = (shower(300), shower(300), shower(300));
         b.broad_phase.no_walk = true;
+        c.broad_phase.no_sweep = true;
         for _ in 0..90 {
-            a.step(1.0 / 60.0).unwrap();
-            b.step(1.0 / 60.0).unwrap();
+            for w in [&mut a, &mut b, &mut c] {
+                w.step(1.0 / 60.0).unwrap();
+            }
         }
-        assert_eq!(b.broad_phase.walks, 0);
-        let walks = a.broad_phase.walks;
-        assert!(walks >= 20, "the tree was walked in {walks} of 90 steps");
+        assert_eq!(b.broad_phase.walks + b.broad_phase.sweep.sweeps, 0);
+        let (sweeps, walks) = (a.broad_phase.sweep.sweeps, c.broad_phase.walks);
+        assert!(sweeps >= 20, "the boxes were swept in {sweeps} of 90 steps");
+        assert_eq!((a.broad_phase.walks, a.broad_phase.sweep.gave_up), (0, 0), "every sweep held");
+        assert_eq!((walks, c.broad_phase.sweep.sweeps), (sweeps, 0), "c walked where a swept");
         let pairs = |w: &World| -> Vec<(u32, u32, bool)> {
             w.contacts
                 .iter()
@@ -1861,11 +1866,13 @@ mod tests {
                 .map(|c| (c.shape_a.index, c.shape_b.index, c.touching))
                 .collect()
         };
-        let (pa, pb) = (pairs(&a), pairs(&b));
+        let (pa, pb, pc) = (pairs(&a), pairs(&b), pairs(&c));
         assert!(pa.iter().filter(|p| p.2).count() > 300, "the boxes have piled up");
         assert_eq!(pa, pb);
-        for ((_, x), (_, y)) in a.bodies.iter().zip(b.bodies.iter()) {
+        assert_eq!(pa, pc);
+        for (((_, x), (_, y)), (_, z)) in a.bodies.iter().zip(b.bodies.iter()).zip(c.bodies.iter()) {
             assert_eq!((x.xf, x.v, x.w), (y.xf, y.v, y.w));
+            assert_eq!((x.xf, x.v, x.w), (z.xf, z.v, z.w));
         }
     }
 

@@ -1,0 +1,289 @@
+//! Sweep and prune: every overlapping pair of a set of boxes, found by sorting the boxes
+//! along one axis and sweeping each box's interval on it (the classic broad phase of
+//! Baraff's thesis, 1992, and Bullet's `btAxisSweep3`; here rebuilt each time it is asked,
+//! for a pile in motion, where most boxes moved since the last step anyway).
+//!
+//! Pipeline stage: broad phase (`World::update_pairs`, when at least half the moving
+//! tree's proxies moved). Neighbour: [`super::tree`], whose leaves it reads and whose
+//! own walk against itself ([`super::tree::FlatTree::self_pairs`]) gives the same pairs and
+//! takes over where a sweep would test too many.
+//!
+//! Why: the tree walk costs a few dozen nanoseconds per overlapping pair found (a
+//! descent through two subtrees per pair of leaves, each step a box test and a stack
+//! write), where the sweep, once the boxes are sorted, tests each box against the boxes
+//! that start inside its interval on the sweep axis, one comparison of each cross-axis
+//! bound per candidate, without branches. In a pile whose extent on the sweep axis is
+//! many boxes wide, each box has a few dozen candidates.
+//!
+//! The pairs are exactly the tree's: two boxes overlap when neither lies wholly beyond the
+//! other on either axis (the same comparisons as [`crate::math::Aabb::overlaps`], for the
+//! finite, not inverted boxes a tree holds), so the pairs a step creates, and so its results, do not depend on which way
+//! they were found.
+
+use super::contact::pair_key;
+use super::tree::DynamicTree;
+
+/// A sweep gives up (and the caller walks the tree instead) past this many candidate
+/// tests per box: with the boxes lined up along both axes (a tall column sorted across
+/// its width, say) every box's interval holds most of the others, and the tree's walk,
+/// which costs per pair found, is then the cheaper. At the limit the sweep's tests have
+/// cost about what the walk costs in a pile (tumbler: ~45 candidates a box).
+const MAX_TESTS_PER_BOX: usize = 64;
+
+/// How many sweeps after one that gave up go straight to the tree walk (the boxes'
+/// arrangement changes slowly: a pile that lined up stays so for a while).
+const BACK_OFF_SWEEPS: u32 = 32;
+
+/// The sweep's buffers, kept between steps (no allocation once warmed up), and its
+/// back-off after a sweep that gave up.
+#[derive(Default, Clone, Debug)]
+pub(crate) struct SweepPrune {
+    /// Sort keys: the box's lower bound on the sweep axis as order-preserving bits, then
+    /// its place in `boxes`.
+    keys: Vec<u64>,
+    /// The boxes as gathered: (min x, min y, max x, max y) [m], user data, moved.
+    boxes: Vec<([f32; 4], u32, bool)>,
+    /// In sweep order: the lower and upper bounds on the sweep axis and the cross axis
+    /// [m], the user data, whether the box moved.
+    lo: Vec<f32>,
+    hi: Vec<f32>,
+    cross_lo: Vec<f32>,
+    cross_hi: Vec<f32>,
+    data: Vec<u32>,
+    moved: Vec<bool>,
+    /// Sweeps left to skip after one gave up.
+    back_off: u32,
+    /// Sweeps made and sweeps that gave up (tests read these).
+    pub sweeps: u64,
+    pub gave_up: u64,
+}
+
+/// `x`'s bits as an unsigned integer in the order of the floats (negative floats' bits
+/// inverted, positive ones' sign bit set), so that sorting the integers sorts the floats.
+#[inline]
+fn ordered_bits(x: f32) -> u32 {
+    let b = x.to_bits();
+    if b >> 31 != 0 {
+        !b
+    } else {
+        b | 0x8000_0000
+    }
+}
+
+impl SweepPrune {
+    /// Pushes onto `out` the [`pair_key`] of every pair of `tree`'s leaves whose boxes
+    /// overlap and at least one of which is marked in `moved` (indexed by the leaves'
+    /// user data, a shape index; unmarked when out of range), in no particular order.
+    /// Returns false, with `out` as it was, when the sweep is not worth it: it would test
+    /// more than [`MAX_TESTS_PER_BOX`] candidates a box (and then for the next
+    /// [`BACK_OFF_SWEEPS`] calls); the caller then walks the tree.
+    pub fn moved_pairs(&mut self, tree: &DynamicTree, moved: &[bool], out: &mut Vec<u64>) -> bool {
+        if self.back_off > 0 {
+            self.back_off -= 1;
+            return false;
+        }
+        self.sweeps += 1;
+        // 1. Gather the leaves, and the spread of their centres on each axis.
+        self.boxes.clear();
+        let (mut sum, mut sum2) = ([0.0f64; 2], [0.0f64; 2]);
+        tree.for_each_leaf(|aabb, data| {
+            // Finite and not inverted, as the sweep's order assumes: the tree takes no
+            // other (`Aabb::is_valid`, checked by every call that sets a proxy's box).
+            debug_assert!(aabb.is_valid());
+            let b = [aabb.min.x, aabb.min.y, aabb.max.x, aabb.max.y];
+            for axis in 0..2 {
+                let c = 0.5 * (b[axis] as f64 + b[axis + 2] as f64);
+                sum[axis] += c;
+                sum2[axis] += c * c;
+            }
+            let shape = data as u32;
+            let m = moved.get(shape as usize).copied().unwrap_or(false);
+            self.boxes.push((b, shape, m));
+        });
+        let n = self.boxes.len();
+        if n < 2 {
+            return true;
+        }
+        // 2. Sort along the axis on which the centres spread the most (their variance ×
+        // n², compared: the boxes then overlap fewest others along it).
+        let spread = |axis: usize| n as f64 * sum2[axis] - sum[axis] * sum[axis];
+        let axis = if spread(1) > spread(0) { 1 } else { 0 };
+        let cross = 1 - axis;
+        self.keys.clear();
+        self.keys.extend(
+            self.boxes
+                .iter()
+                .enumerate()
+                .map(|(i, (b, _, _))| (u64::from(ordered_bits(b[axis])) << 32) | i as u64),
+        );
+        self.keys.sort_unstable();
+        self.lo.clear();
+        self.hi.clear();
+        self.cross_lo.clear();
+        self.cross_hi.clear();
+        self.data.clear();
+        self.moved.clear();
+        for &key in &self.keys {
+            let Some(&(b, d, m)) = self.boxes.get(key as u32 as usize) else {
+                continue;
+            };
+            self.lo.push(b[axis]);
+            self.hi.push(b[axis + 2]);
+            self.cross_lo.push(b[cross]);
+            self.cross_hi.push(b[cross + 2]);
+            self.data.push(d);
+            self.moved.push(m);
+        }
+        // 3. Sweep: box i against the boxes after it that start inside its interval. Each
+        // of those also ends after box i starts (it starts no earlier and a box ends no
+        // earlier than it starts), so only the cross axis is left to test. Pairs are
+        // written without a branch: every candidate's key is stored and the count moves
+        // on only for a hit (which candidates hit is data, not a pattern the branch
+        // predictor learns).
+        let start = out.len();
+        let budget = MAX_TESTS_PER_BOX * n;
+        let mut tests = 0usize;
+        let mut len = start;
+        let (lo, hi, cross_lo, cross_hi, data, moved) =
+            (&self.lo, &self.hi, &self.cross_lo, &self.cross_hi, &self.data, &self.moved);
+        for i in 0..n {
+            let (Some(&end), Some(&c_lo), Some(&c_hi), Some(&d), Some(&m)) =
+                (hi.get(i), cross_lo.get(i), cross_hi.get(i), data.get(i), moved.get(i))
+            else {
+                break;
+            };
+            let last = i + 1 + lo.get(i + 1..).map_or(0, |rest| rest.partition_point(|&l| l <= end));
+            tests += last - i - 1;
+            if tests > budget {
+                out.truncate(start);
+                self.back_off = BACK_OFF_SWEEPS;
+                self.gave_up += 1;
+                return false;
+            }
+            out.resize(len + (last - i - 1), 0);
+            let (Some(slots), Some(lo_c), Some(hi_c), Some(ds), Some(ms)) = (
+                out.get_mut(len..),
+                cross_lo.get(i + 1..last),
+                cross_hi.get(i + 1..last),
+                data.get(i + 1..last),
+                moved.get(i + 1..last),
+            ) else {
+                break;
+            };
+            let mut hits = 0usize;
+            for ((((&l, &h), &dj), &mj), _) in lo_c.iter().zip(hi_c).zip(ds).zip(ms).zip(0..slots.len()) {
+                let hit = (l <= c_hi) & (c_lo <= h) & (m | mj);
+                if let Some(slot) = slots.get_mut(hits) {
+                    *slot = pair_key(d, dj);
+                }
+                hits += hit as usize;
+            }
+            len += hits;
+            out.truncate(len);
+        }
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::{Aabb, Vec2};
+
+    /// A small deterministic generator (xorshift), for boxes.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
+    /// Every pair of `boxes` (by index) that overlaps with at least one moved, by testing
+    /// every pair with `Aabb::overlaps`.
+    fn brute(boxes: &[(Aabb, bool)]) -> Vec<u64> {
+        let mut out = Vec::new();
+        for (i, a) in boxes.iter().enumerate() {
+            for (j, b) in boxes.iter().enumerate().skip(i + 1) {
+                if a.0.overlaps(b.0) && (a.1 || b.1) {
+                    out.push(pair_key(i as u32, j as u32));
+                }
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+
+    fn swept(boxes: &[(Aabb, bool)]) -> Option<Vec<u64>> {
+        let mut tree = DynamicTree::new();
+        for (i, (b, _)) in boxes.iter().enumerate() {
+            tree.create_proxy(*b, 1, i as u64);
+        }
+        let moved: Vec<bool> = boxes.iter().map(|b| b.1).collect();
+        let mut sp = SweepPrune::default();
+        let mut out = vec![7];
+        let ok = sp.moved_pairs(&tree, &moved, &mut out);
+        assert_eq!(out.first(), Some(&7), "the sweep keeps what `out` held");
+        out.remove(0);
+        out.sort_unstable();
+        ok.then_some(out)
+    }
+
+    /// The sweep finds exactly the pairs a test of every pair finds: random boxes of
+    /// mixed sizes (some sharing bounds, some only touching, so the ≤ comparisons are
+    /// checked at equality), with and without moved marks, spread wide in x or in y (so
+    /// both sweep axes are taken).
+    #[test]
+    fn sweep_finds_exactly_the_overlapping_pairs() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        for case in 0..40 {
+            let n = 5 + case * 7;
+            let (wide_x, wide_y) = if case % 2 == 0 { (30.0, 5.0) } else { (5.0, 30.0) };
+            let mut boxes = Vec::new();
+            for k in 0..n {
+                let (x, y) = ((rng.next() * wide_x).round() * 0.5, (rng.next() * wide_y).round() * 0.5);
+                let (w, h) = (0.5 + (rng.next() * 4.0).round() * 0.25, 0.5 + (rng.next() * 4.0).round() * 0.25);
+                let moved = case % 3 != 0 || k % 4 == 0;
+                boxes.push((Aabb::new(Vec2::new(x, y), Vec2::new(x + w, y + h)), moved));
+            }
+            let want = brute(&boxes);
+            assert!(case < 3 || !want.is_empty(), "case {case} has pairs");
+            assert_eq!(swept(&boxes), Some(want), "case {case}");
+        }
+    }
+
+    /// A column of boxes lined up on both axes (each box's interval holds all the others
+    /// on either axis) is too many tests a box: the sweep gives up, leaves `out` as it was,
+    /// and skips the next sweeps.
+    #[test]
+    fn sweep_gives_up_on_boxes_lined_up_on_both_axes() {
+        let boxes: Vec<(Aabb, bool)> = (0..200)
+            .map(|k| {
+                let t = k as f32 * 0.001;
+                (Aabb::new(Vec2::new(t, t), Vec2::new(t + 1.0, t + 1.0)), true)
+            })
+            .collect();
+        assert_eq!(brute(&boxes).len(), 200 * 199 / 2, "every pair overlaps");
+        assert_eq!(swept(&boxes), None);
+        let mut tree = DynamicTree::new();
+        tree.create_proxy(Aabb::new(Vec2::ZERO, Vec2::new(1.0, 1.0)), 1, 0);
+        tree.create_proxy(Aabb::new(Vec2::ZERO, Vec2::new(1.0, 1.0)), 1, 1);
+        let mut sp = SweepPrune {
+            back_off: BACK_OFF_SWEEPS,
+            ..SweepPrune::default()
+        };
+        let mut out = Vec::new();
+        assert!(!sp.moved_pairs(&tree, &[true, true], &mut out), "backing off");
+        assert_eq!(sp.back_off, BACK_OFF_SWEEPS - 1);
+    }
+
+    #[test]
+    fn ordered_bits_sort_as_the_floats() {
+        let xs = [-1e30f32, -2.5, -1.0, -0.0, 0.0, 1e-30, 0.5, 3.0, 1e30];
+        for w in xs.windows(2) {
+            assert!(ordered_bits(w[0]) <= ordered_bits(w[1]), "{} {}", w[0], w[1]);
+        }
+    }
+}
