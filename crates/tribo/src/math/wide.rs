@@ -629,6 +629,15 @@ impl M4 {
         )
     }
 
+    /// The lanes as the low four bits of a word (lane i: bit i).
+    #[inline(always)]
+    pub fn bits(self) -> u32 {
+        simd!(
+            _mm_movemask_ps(sse::m(self)) as u32,
+            (0..LANES4).fold(0, |b, i| b | (((self[i] != 0) as u32) << i))
+        )
+    }
+
     /// Whether some lane is true.
     #[inline(always)]
     pub fn any(self) -> bool {

@@ -1857,8 +1857,16 @@ mod tests {
         assert_eq!(b.broad_phase.walks + b.broad_phase.sweep.sweeps, 0);
         let (sweeps, walks) = (a.broad_phase.sweep.sweeps, c.broad_phase.walks);
         assert!(sweeps >= 20, "the boxes were swept in {sweeps} of 90 steps");
-        assert_eq!((a.broad_phase.walks, a.broad_phase.sweep.gave_up), (0, 0), "every sweep held");
-        assert_eq!((walks, c.broad_phase.sweep.sweeps), (sweeps, 0), "c walked where a swept");
+        assert_eq!(
+            (a.broad_phase.walks, a.broad_phase.sweep.gave_up),
+            (0, 0),
+            "every sweep held"
+        );
+        assert_eq!(
+            (walks, c.broad_phase.sweep.sweeps),
+            (sweeps, 0),
+            "c walked where a swept"
+        );
         let pairs = |w: &World| -> Vec<(u32, u32, bool)> {
             w.contacts
                 .iter()
