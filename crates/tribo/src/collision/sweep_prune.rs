@@ -70,9 +70,13 @@ const BACK_OFF_SWEEPS: u32 = 32;
 /// back-off after a sweep that gave up.
 #[derive(Default, Clone, Debug)]
 pub(crate) struct SweepPrune {
-    /// Sort keys: the band, the box's lower bound on the sweep axis as order-preserving
-    /// bits, and its place in `boxes`.
-    keys: Vec<(u64, u32)>,
+    /// Sort keys, band after band: the box's lower bound on the sweep axis as
+    /// order-preserving bits, then its place in `boxes`.
+    keys: Vec<u64>,
+    /// Where each band's entries start in `keys` (and the end), and the next free place
+    /// of each band while they are filled.
+    starts: Vec<u32>,
+    fill: Vec<u32>,
     /// The boxes as gathered: (min x, min y, max x, max y) [m], user data, moved.
     boxes: Vec<([f32; 4], u32, bool)>,
     /// In sweep order: the lower and upper bounds on the sweep axis and the cross axis
@@ -166,14 +170,40 @@ impl SweepPrune {
             last: bands.max(1) - 1,
         };
         self.bands = bands.last + 1;
-        self.keys.clear();
-        for (i, (b, _, _)) in self.boxes.iter().enumerate() {
-            let key = u64::from(ordered_bits(b[axis]));
+        // The entries placed band by band (a count, then each band's share), and each
+        // band's keys sorted on their own: smaller sorts, of plain words.
+        let band_count = bands.last as usize + 1;
+        self.starts.clear();
+        self.starts.resize(band_count + 1, 0);
+        for (b, _, _) in &self.boxes {
             for band in bands.of(b[cross])..=bands.of(b[cross + 2]) {
-                self.keys.push(((u64::from(band) << 32) | key, i as u32));
+                if let Some(c) = self.starts.get_mut(band as usize + 1) {
+                    *c += 1;
+                }
             }
         }
-        self.keys.sort_unstable();
+        for k in 1..self.starts.len() {
+            let before = self.starts.get(k - 1).copied().unwrap_or(0);
+            if let Some(c) = self.starts.get_mut(k) {
+                *c += before;
+            }
+        }
+        let entries = self.starts.last().copied().unwrap_or(0) as usize;
+        self.keys.clear();
+        self.keys.resize(entries, 0);
+        self.fill.clear();
+        self.fill.extend_from_slice(&self.starts);
+        for (i, (b, _, _)) in self.boxes.iter().enumerate() {
+            let key = (u64::from(ordered_bits(b[axis])) << 32) | i as u64;
+            for band in bands.of(b[cross])..=bands.of(b[cross + 2]) {
+                if let Some(at) = self.fill.get_mut(band as usize) {
+                    if let Some(slot) = self.keys.get_mut(*at as usize) {
+                        *slot = key;
+                    }
+                    *at += 1;
+                }
+            }
+        }
         self.lo.clear();
         self.hi.clear();
         self.cross_lo.clear();
@@ -184,38 +214,36 @@ impl SweepPrune {
         // Each band's boxes followed by a chunk of padding that starts past every interval
         // (and, swept itself, ends before any), so the sweep reads whole chunks without a
         // bounds test of its own and stops at the band's end.
-        let pad = |sp: &mut SweepPrune| {
-            for _ in 0..CHUNK {
-                sp.lo.push(f32::INFINITY);
-                sp.hi.push(f32::NEG_INFINITY);
-                sp.cross_lo.push(0.0);
-                sp.cross_hi.push(0.0);
-                sp.data.push(0);
-                sp.moved.push(false);
-                sp.band.push(u32::MAX);
-            }
-        };
-        let keys = core::mem::take(&mut self.keys);
-        let mut current = None;
-        for &(key, i) in &keys {
-            let Some(&(b, d, m)) = self.boxes.get(i as usize) else {
+        for band in 0..band_count {
+            let (Some(&from), Some(&to)) = (self.starts.get(band), self.starts.get(band + 1)) else {
                 continue;
             };
-            let band = (key >> 32) as u32;
-            if current.is_some_and(|c| c != band) {
-                pad(self);
+            let Some(keys) = self.keys.get_mut(from as usize..to as usize) else {
+                continue;
+            };
+            keys.sort_unstable();
+            for &key in keys.iter() {
+                let Some(&(b, d, m)) = self.boxes.get(key as u32 as usize) else {
+                    continue;
+                };
+                self.lo.push(b[axis]);
+                self.hi.push(b[axis + 2]);
+                self.cross_lo.push(b[cross]);
+                self.cross_hi.push(b[cross + 2]);
+                self.data.push(d);
+                self.moved.push(m);
+                self.band.push(band as u32);
             }
-            current = Some(band);
-            self.lo.push(b[axis]);
-            self.hi.push(b[axis + 2]);
-            self.cross_lo.push(b[cross]);
-            self.cross_hi.push(b[cross + 2]);
-            self.data.push(d);
-            self.moved.push(m);
-            self.band.push(band);
+            for _ in 0..CHUNK {
+                self.lo.push(f32::INFINITY);
+                self.hi.push(f32::NEG_INFINITY);
+                self.cross_lo.push(0.0);
+                self.cross_hi.push(0.0);
+                self.data.push(0);
+                self.moved.push(false);
+                self.band.push(u32::MAX);
+            }
         }
-        pad(self);
-        self.keys = keys;
         // 3. Sweep ([`sweep_sorted`]).
         let start = out.len();
         let swept = sweep_sorted(
