@@ -77,11 +77,15 @@ pub(crate) struct BroadPhase {
     pub moved_mark: Vec<bool>,
     /// Pair updates that walked the moving tree against itself (diagnostics and tests).
     pub walks: u64,
+    /// Moves in the moving tree refit it later, all at once ([`BroadPhase::refit`]): on
+    /// during a step's finalize, which moves most proxies of a pile in motion and queries
+    /// only the static tree.
+    pub defer_refits: bool,
     /// Sweep and prune over the moving tree's boxes (its buffers and back-off), tried
     /// before that walk.
     pub sweep: SweepPrune,
-    /// Tests: never walk the tree, query per moved shape (the reference the walk must
-    /// match).
+    /// Tests: never find the moving tree's pairs all at once (no sweep, no walk), query
+    /// per moved shape (the reference the sweep and the walk must match).
     #[cfg(test)]
     pub no_walk: bool,
     /// Tests: walk the tree without trying the sweep first.
@@ -122,10 +126,24 @@ impl BroadPhase {
         self.trees[tree as usize].destroy_proxy(proxy);
     }
 
-    /// Moves a proxy to a new fat box and marks its shape as moved.
+    /// Moves a proxy to a new fat box and marks its shape as moved. While
+    /// [`BroadPhase::defer_refits`] is on, a near move in the moving tree leaves the tree's
+    /// refit to [`BroadPhase::refit`].
     pub fn move_proxy(&mut self, tree: u8, proxy: u32, aabb: Aabb, shape_index: u32) {
-        self.trees[tree as usize].move_proxy_near(proxy, aabb);
+        if self.defer_refits && tree == MOVING_TREE {
+            self.trees[tree as usize].move_proxy_deferred(proxy, aabb);
+        } else {
+            self.trees[tree as usize].move_proxy_near(proxy, aabb);
+        }
         self.moved.push(shape_index);
+    }
+
+    /// Refits the trees whose moves were deferred, and stops deferring.
+    pub fn refit(&mut self) {
+        self.defer_refits = false;
+        for tree in &mut self.trees {
+            tree.refit_all();
+        }
     }
 }
 

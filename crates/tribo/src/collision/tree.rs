@@ -160,6 +160,13 @@ pub struct DynamicTree {
     search_budget: u32,
     /// Counts the changes to the tree (a [`FlatTree`] made from it knows which one it is).
     revision: u64,
+    /// Leaf boxes were written without refitting their ancestors
+    /// ([`move_proxy_deferred`](Self::move_proxy_deferred)): no query until
+    /// [`refit_all`](Self::refit_all).
+    unfitted: bool,
+    /// Scratch of `refit_all`: the walk's stack and the internal nodes in preorder.
+    refit_order: Vec<u32>,
+    refit_stack: Vec<u32>,
 }
 
 impl Default for DynamicTree {
@@ -179,6 +186,9 @@ impl DynamicTree {
             search: Vec::new(),
             search_budget: DEFAULT_SEARCH_BUDGET,
             revision: 0,
+            unfitted: false,
+            refit_order: Vec::new(),
+            refit_stack: Vec::new(),
         }
     }
 
@@ -301,6 +311,69 @@ impl DynamicTree {
         true
     }
 
+    /// [`move_proxy_near`](Self::move_proxy_near) for one of many proxies moved in a row:
+    /// a near proxy's box is written and its ancestors are left as they are, all of them
+    /// refitted at once by [`refit_all`](Self::refit_all), which must come before the next
+    /// query (a pile in motion moves most of its proxies each step, and each refit walked
+    /// from its leaf towards the root). A proxy that left its neighbourhood is reinserted
+    /// (its search reads boxes that may be stale: a worse place, never a wrong tree, once
+    /// refitted). Returns false when `proxy` is not a live proxy or `aabb` is not valid.
+    pub fn move_proxy_deferred(&mut self, proxy: u32, aabb: Aabb) -> bool {
+        self.revision += 1;
+        if !self.is_proxy(proxy) || !aabb.is_valid() {
+            return false;
+        }
+        let parent = self.nodes[proxy as usize].parent;
+        if parent != NULL_NODE {
+            let p = &self.nodes[parent as usize];
+            let sibling = p.child1 ^ p.child2 ^ proxy;
+            let reach = (aabb.max - aabb.min).x.max((aabb.max - aabb.min).y);
+            if !aabb.overlaps(self.nodes[sibling as usize].aabb.expand(reach)) {
+                return self.move_proxy(proxy, aabb);
+            }
+            self.unfitted = true;
+        }
+        self.nodes[proxy as usize].aabb = aabb;
+        true
+    }
+
+    /// Makes every internal node's box, category bits and height those of its children
+    /// again, children before parents (the internal nodes in reverse preorder), after
+    /// [`move_proxy_deferred`](Self::move_proxy_deferred); nothing when none is pending.
+    pub fn refit_all(&mut self) {
+        if !self.unfitted {
+            return;
+        }
+        self.unfitted = false;
+        self.revision += 1;
+        let (mut order, mut stack) = (
+            core::mem::take(&mut self.refit_order),
+            core::mem::take(&mut self.refit_stack),
+        );
+        order.clear();
+        stack.clear();
+        if self.root != NULL_NODE {
+            stack.push(self.root);
+        }
+        while let Some(i) = stack.pop() {
+            let Some(n) = self.nodes.get(i as usize) else { continue };
+            if !n.is_leaf() {
+                order.push(i);
+                stack.push(n.child1);
+                stack.push(n.child2);
+            }
+        }
+        for &i in order.iter().rev() {
+            self.refit(i);
+        }
+        (self.refit_order, self.refit_stack) = (order, stack);
+    }
+
+    /// Whether [`refit_all`](Self::refit_all) is pending.
+    pub fn unfitted(&self) -> bool {
+        self.unfitted
+    }
+
     /// Cheap alternative to [`move_proxy`](Self::move_proxy) for a box that slightly
     /// outgrew its fat box: the leaf box becomes `leaf ∪ aabb` and the ancestors are grown
     /// in place (stopping at the first one that already holds it). No reinsertion, so tree
@@ -357,6 +430,7 @@ impl DynamicTree {
     /// counts) and whose `category_bits & mask_bits != 0`. The callback returns false to
     /// stop the query. Iterative (explicit stack), no allocation for trees of sane height.
     pub fn query<F: FnMut(u32, u64) -> bool>(&self, aabb: Aabb, mask_bits: u64, mut callback: F) {
+        debug_assert!(!self.unfitted, "a tree queried before its refit");
         self.walk(|id, n| {
             if n.category_bits & mask_bits == 0 || !n.aabb.overlaps(aabb) {
                 Walk::Skip
@@ -433,6 +507,7 @@ impl DynamicTree {
         mask_bits: u64,
         mut callback: F,
     ) {
+        debug_assert!(!self.unfitted, "a tree queried before its refit");
         if self.root == NULL_NODE || !origin.is_finite() || !translation.is_finite() {
             return;
         }
@@ -1342,6 +1417,7 @@ impl FlatTree {
 impl DynamicTree {
     /// Makes `out` a [`FlatTree`] copy of this tree (reusing its buffers).
     pub fn flatten_into(&self, out: &mut FlatTree) {
+        debug_assert!(!self.unfitted, "a tree queried before its refit");
         out.nodes.clear();
         out.data.clear();
         out.single = None;
@@ -1504,6 +1580,26 @@ mod tests {
                     assert!(t.destroy_proxy(id));
                     assert!(!t.destroy_proxy(id), "double destroy must fail");
                 }
+            }
+            // A round of deferred moves (a pile in motion in one step's finalize), small
+            // ones (kept in place) and far ones (reinserted), refitted once: the tree is
+            // whole again (every internal box holds its children's: `validate`).
+            if !live.is_empty() {
+                for _ in 0..40 {
+                    let k = r.below(live.len());
+                    let old = live[k].1;
+                    let b = if r.below(4) != 0 {
+                        let d = Vec2::new(r.range(-0.5, 0.5), r.range(-0.5, 0.5));
+                        Aabb::new(old.min + d, old.max + d)
+                    } else {
+                        random_box(&mut r, 100.0, 8.0)
+                    };
+                    assert!(t.move_proxy_deferred(live[k].0, b));
+                    live[k].1 = b;
+                }
+                assert!(t.unfitted() || live.len() < 2, "small moves leave a refit pending");
+                t.refit_all();
+                assert!(!t.unfitted());
             }
             t.validate().unwrap_or_else(|e| panic!("batch {batch}: {e}"));
             assert_eq!(t.proxy_count(), live.len());

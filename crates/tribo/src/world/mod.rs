@@ -1867,6 +1867,8 @@ mod tests {
             (sweeps, 0),
             "c walked where a swept"
         );
+        let bands = a.broad_phase.sweep.most_bands;
+        assert!(bands >= 3, "the shower was swept in bands: at most {bands}");
         let pairs = |w: &World| -> Vec<(u32, u32, bool)> {
             w.contacts
                 .iter()
