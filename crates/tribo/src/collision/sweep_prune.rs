@@ -98,6 +98,10 @@ pub(crate) struct SweepPrune {
     data: Vec<u32>,
     moved: Vec<bool>,
     band: Vec<u32>,
+    /// In sweep order: the first band of the entry's box.
+    first: Vec<u32>,
+    /// Each box's first and last band.
+    spans: Vec<(u32, u32)>,
     /// The sweep's scratch: one box's hits.
     hits: Vec<u32>,
     /// Sweeps left to skip after one gave up.
@@ -187,8 +191,11 @@ impl SweepPrune {
         let band_count = bands.last as usize + 1;
         self.starts.clear();
         self.starts.resize(band_count + 1, 0);
+        self.spans.clear();
         for (b, _, _) in &self.boxes {
-            for band in bands.of(b[cross])..=bands.of(b[cross + 2]) {
+            let span = (bands.of(b[cross]), bands.of(b[cross + 2]));
+            self.spans.push(span);
+            for band in span.0..=span.1 {
                 if let Some(c) = self.starts.get_mut(band as usize + 1) {
                     *c += 1;
                 }
@@ -205,9 +212,9 @@ impl SweepPrune {
         self.keys.resize(entries, 0);
         self.fill.clear();
         self.fill.extend_from_slice(&self.starts);
-        for (i, (b, _, _)) in self.boxes.iter().enumerate() {
+        for (i, ((b, _, _), &(first, last))) in self.boxes.iter().zip(&self.spans).enumerate() {
             let key = (u64::from(ordered_bits(b[axis])) << 32) | i as u64;
-            for band in bands.of(b[cross])..=bands.of(b[cross + 2]) {
+            for band in first..=last {
                 if let Some(at) = self.fill.get_mut(band as usize) {
                     if let Some(slot) = self.keys.get_mut(*at as usize) {
                         *slot = key;
@@ -223,6 +230,7 @@ impl SweepPrune {
         self.data.clear();
         self.moved.clear();
         self.band.clear();
+        self.first.clear();
         // Each band's boxes followed by a chunk of padding that no interval holds (its lower
         // bound NaN: no comparison with it is true) and that is not swept itself (band
         // `PADDING`), so the sweep reads whole chunks without a bounds test of its own and
@@ -236,7 +244,9 @@ impl SweepPrune {
             };
             keys.sort_unstable();
             for &key in keys.iter() {
-                let Some(&(b, d, m)) = self.boxes.get(key as u32 as usize) else {
+                let (Some(&(b, d, m)), Some(&(first, _))) =
+                    (self.boxes.get(key as u32 as usize), self.spans.get(key as u32 as usize))
+                else {
                     continue;
                 };
                 self.lo.push(b[axis]);
@@ -246,6 +256,7 @@ impl SweepPrune {
                 self.data.push(d);
                 self.moved.push(m);
                 self.band.push(band as u32);
+                self.first.push(first);
             }
             for _ in 0..CHUNK {
                 self.lo.push(f32::NAN);
@@ -255,6 +266,7 @@ impl SweepPrune {
                 self.data.push(0);
                 self.moved.push(false);
                 self.band.push(PADDING);
+                self.first.push(PADDING);
             }
         }
         // 3. Sweep ([`sweep_sorted`]).
@@ -263,7 +275,7 @@ impl SweepPrune {
             [&self.lo, &self.hi, &self.cross_lo, &self.cross_hi],
             &self.data,
             &self.moved,
-            (&self.band, bands),
+            [&self.band, &self.first],
             MAX_TESTS_PER_BOX * n,
             &mut self.hits,
             out,
@@ -291,16 +303,19 @@ fn sweep_sorted(
     bounds: [&[f32]; 4],
     data: &[u32],
     moved: &[bool],
-    (band_of_entry, bands): (&[u32], Bands),
+    [band_of_entry, first_band]: [&[u32]; 2],
     budget: usize,
     hits: &mut Vec<u32>,
     out: &mut Vec<u64>,
 ) -> bool {
     // The arrays cut to one length, which one test per chunk then covers.
-    let len = bounds
-        .iter()
-        .map(|b| b.len())
-        .fold(data.len().min(moved.len()).min(band_of_entry.len()), usize::min);
+    let len = bounds.iter().map(|b| b.len()).fold(
+        data.len()
+            .min(moved.len())
+            .min(band_of_entry.len())
+            .min(first_band.len()),
+        usize::min,
+    );
     let [lo, hi, cross_lo, cross_hi] = bounds.map(|b| b.get(..len).unwrap_or(&[]));
     let n = len.saturating_sub(CHUNK);
     // A box's hits (places in sweep order), written in the loop, which then calls nothing
@@ -319,6 +334,7 @@ fn sweep_sorted(
         ) else {
             break;
         };
+        let first = first_band.get(i).copied().unwrap_or(PADDING);
         if band == PADDING {
             continue;
         }
@@ -353,8 +369,10 @@ fn sweep_sorted(
         }
         for &k in hits.get(..count).unwrap_or(&[]) {
             let k = k as usize;
-            if let (Some(&dk), Some(&mk), Some(&c_lo_k)) = (data.get(k), moved.get(k), cross_lo.get(k)) {
-                if (m | mk) && bands.of(c_lo.max(c_lo_k)) == band {
+            // Kept in the band of the larger cross lower bound: the later of the two
+            // boxes' first bands (`Bands::of` does not decrease).
+            if let (Some(&dk), Some(&mk), Some(&first_k)) = (data.get(k), moved.get(k), first_band.get(k)) {
+                if (m | mk) && first.max(first_k) == band {
                     out.push(pair_key(d, dk));
                 }
             }
