@@ -1886,6 +1886,48 @@ mod tests {
         }
     }
 
+    /// Boxes heaped on one spot (each box's interval holds all the others on both axes):
+    /// the sweep gives up, backs off, and the walk finds the pairs instead, the same as a
+    /// world that always queries; the tree, refitted after each finalize, answers both.
+    #[test]
+    fn a_crowded_heap_falls_back_to_the_walk() {
+        let heap = || {
+            let (mut w, _) = sleepless_with_ground();
+            let cube = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
+            for k in 0..300 {
+                let at = Vec2::new(0.001 * (k % 20) as f32, 0.001 * (k / 20) as f32);
+                let b = w.create_body(&BodyDef::dynamic(at)).unwrap();
+                w.create_shape(b, &ShapeDef::default(), &cube).unwrap();
+            }
+            w
+        };
+        let (mut a, mut b) = (heap(), heap());
+        b.broad_phase.no_walk = true;
+        for _ in 0..3 {
+            a.step(1.0 / 60.0).unwrap();
+            b.step(1.0 / 60.0).unwrap();
+        }
+        let sweep = &a.broad_phase.sweep;
+        assert_eq!(
+            (sweep.sweeps, sweep.gave_up),
+            (1, 1),
+            "the first sweep gave up, the next backed off"
+        );
+        assert!(a.broad_phase.walks >= 1);
+        let pairs = |w: &World| -> Vec<(u32, u32)> {
+            w.contacts
+                .iter()
+                .flatten()
+                .map(|c| (c.shape_a.index, c.shape_b.index))
+                .collect()
+        };
+        assert!(pairs(&a).len() > 300 * 299 / 4, "the heap's boxes overlap");
+        assert_eq!(pairs(&a), pairs(&b));
+        for ((_, x), (_, y)) in a.bodies.iter().zip(b.bodies.iter()) {
+            assert_eq!((x.xf, x.v, x.w), (y.xf, y.v, y.w));
+        }
+    }
+
     #[test]
     fn a_slow_shape_keeps_its_unswept_box() {
         // half 0.1 m: thickness 0.1 m, free 0.05 m per step (sweep_free); 2 m/s at 1/60 s
