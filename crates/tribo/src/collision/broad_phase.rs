@@ -77,9 +77,9 @@ pub(crate) struct BroadPhase {
     pub moved_mark: Vec<bool>,
     /// Pair updates that walked the moving tree against itself (diagnostics and tests).
     pub walks: u64,
-    /// Moves in the moving tree refit it later, all at once ([`BroadPhase::refit`]): on
-    /// during a step's finalize, which moves most proxies of a pile in motion and queries
-    /// only the static tree.
+    /// Near moves in the moving tree refit it later, all at once ([`BroadPhase::refit`];
+    /// a far move is reinserted at once): on during a step's finalize, which moves most
+    /// proxies of a pile in motion and queries only the static tree.
     pub defer_refits: bool,
     /// Sweep and prune over the moving tree's boxes (its buffers and back-off), tried
     /// before that walk.

@@ -1,7 +1,8 @@
 //! Dynamic AABB tree (bounding-volume hierarchy) used by the broad phase.
 //!
 //! Pipeline stage: broad phase. Every shape proxy is a leaf holding a (caller-fattened) box;
-//! internal nodes hold the union of their two children. Queries and ray casts walk the tree
+//! internal nodes hold the union of their two children (except between
+//! `DynamicTree::move_proxy_deferred` and `DynamicTree::refit_all`, when no query may come). Queries and ray casts walk the tree
 //! with an explicit stack and prune whole subtrees whose box misses or whose category union
 //! does not match the mask.
 //!
@@ -144,6 +145,10 @@ enum Rotation {
     DG,
 }
 
+/// [`DynamicTree::refit_all`] refits leaf by leaf when fewer than 1 in this many proxies
+/// were moved by `move_proxy_deferred`, else the whole tree.
+const FEW_DEFERRED: usize = 8;
+
 /// A dynamic AABB tree of proxies. Proxy ids are node indices; they stay valid until the
 /// proxy is destroyed, across moves and [`rebuild`](Self::rebuild). A destroyed id may be
 /// handed out again by a later [`create_proxy`](Self::create_proxy) (no generation counter),
@@ -164,8 +169,11 @@ pub struct DynamicTree {
     /// ([`move_proxy_deferred`](Self::move_proxy_deferred)): no query until
     /// [`refit_all`](Self::refit_all).
     unfitted: bool,
-    /// Scratch of `refit_all`: the walk's stack and the internal nodes in preorder.
+    /// The leaves so written since the last refit.
+    deferred: Vec<u32>,
+    /// Scratch of `refit_all`: the internal nodes in preorder.
     refit_order: Vec<u32>,
+    /// Scratch of `refit_all`: its walk's stack.
     refit_stack: Vec<u32>,
 }
 
@@ -187,6 +195,7 @@ impl DynamicTree {
             search_budget: DEFAULT_SEARCH_BUDGET,
             revision: 0,
             unfitted: false,
+            deferred: Vec::new(),
             refit_order: Vec::new(),
             refit_stack: Vec::new(),
         }
@@ -332,20 +341,45 @@ impl DynamicTree {
                 return self.move_proxy(proxy, aabb);
             }
             self.unfitted = true;
+            self.deferred.push(proxy);
         }
         self.nodes[proxy as usize].aabb = aabb;
         true
     }
 
     /// Makes every internal node's box, category bits and height those of its children
-    /// again, children before parents (the internal nodes in reverse preorder), after
-    /// [`move_proxy_deferred`](Self::move_proxy_deferred); nothing when none is pending.
+    /// again after [`move_proxy_deferred`](Self::move_proxy_deferred); nothing when none
+    /// is pending. When few leaves were so moved (under 1 in [`FEW_DEFERRED`] of the
+    /// proxies: a sleeping pile with a few bodies awake), each one's ancestors are refitted
+    /// from it upwards, up to the first one unchanged, as `move_proxy_near` does (a node
+    /// left stale is on the path of a later leaf, whose walk refits it from its current
+    /// children, or its children did not change); otherwise every internal node once,
+    /// children before parents (the internal nodes in reverse preorder).
     pub fn refit_all(&mut self) {
         if !self.unfitted {
             return;
         }
         self.unfitted = false;
         self.revision += 1;
+        let mut deferred = core::mem::take(&mut self.deferred);
+        if deferred.len() * FEW_DEFERRED < self.proxy_count {
+            for &leaf in &deferred {
+                let mut i = self.nodes.get(leaf as usize).map_or(NULL_NODE, |n| n.parent);
+                while let Some(n) = self.nodes.get(i as usize) {
+                    let before = n.aabb;
+                    self.refit(i);
+                    if self.nodes[i as usize].aabb.same(before) {
+                        break; // every further ancestor is unchanged too
+                    }
+                    i = self.nodes[i as usize].parent;
+                }
+            }
+            deferred.clear();
+            self.deferred = deferred;
+            return;
+        }
+        deferred.clear();
+        self.deferred = deferred;
         let (mut order, mut stack) = (
             core::mem::take(&mut self.refit_order),
             core::mem::take(&mut self.refit_stack),
@@ -701,6 +735,9 @@ impl DynamicTree {
     /// nodes are recreated. O(n log n); allocates temporary buffers. Deterministic.
     pub fn rebuild(&mut self) {
         self.revision += 1;
+        // Every internal node is made again from the leaves: nothing left to refit.
+        self.unfitted = false;
+        self.deferred.clear();
         let mut leaves: Vec<u32> = Vec::with_capacity(self.proxy_count);
         let mut free_slots: Vec<u32> = Vec::new();
         for (i, n) in self.nodes.iter().enumerate() {
@@ -1583,7 +1620,9 @@ mod tests {
             }
             // A round of deferred moves (a pile in motion in one step's finalize), small
             // ones (kept in place) and far ones (reinserted), refitted once: the tree is
-            // whole again (every internal box holds its children's: `validate`).
+            // whole again (every internal box holds its children's: `validate`). The first
+            // batches, with few proxies, refit the whole tree; the later ones, with over
+            // 8 × 40, leaf by leaf.
             if !live.is_empty() {
                 for _ in 0..40 {
                     let k = r.below(live.len());

@@ -451,9 +451,10 @@ mod tests {
     }
 
     /// Every operation gives each lane what the scalar expression gives, NaN and signed
-    /// zeros included (the same rules as the four-lane operations; a NaN's sign and
-    /// payload are not compared: a debug build computes 0 / −0 as a positive NaN, the
-    /// division instruction a negative one).
+    /// zeros included (the same rules as the four-lane operations). A NaN that an operation
+    /// makes from numbers (0 / −0, the square root of −2) is only required to be NaN: the
+    /// instruction makes it negative, a scalar reference the compiler folds positive (the
+    /// test profile is optimised).
     #[test]
     fn eight_lanes_match_scalar_arithmetic() {
         if !avx2() {
@@ -464,8 +465,14 @@ mod tests {
         let (a, b) = (F8::new(xs), F8::new(ys));
         let same = |v: F8, f: &dyn Fn(f32, f32) -> f32| {
             for l in 0..LANES8 {
+                assert_eq!(v[l].to_bits(), f(xs[l], ys[l]).to_bits(), "lane {l}");
+            }
+        };
+        // Exact bits, but any NaN where the scalar gives one made from two numbers.
+        let made = |v: F8, f: &dyn Fn(f32, f32) -> f32| {
+            for l in 0..LANES8 {
                 let want = f(xs[l], ys[l]);
-                if want.is_nan() {
+                if want.is_nan() && !xs[l].is_nan() && !ys[l].is_nan() {
                     assert!(v[l].is_nan(), "lane {l}: {} for NaN", v[l]);
                 } else {
                     assert_eq!(v[l].to_bits(), want.to_bits(), "lane {l}");
@@ -475,10 +482,10 @@ mod tests {
         same(a + b, &|x, y| x + y);
         same(a - b, &|x, y| x - y);
         same(a * b, &|x, y| x * y);
-        same(a / b, &|x, y| x / y);
+        made(a / b, &|x, y| x / y);
         same(-a, &|x, _| -x);
         same(a.abs(), &|x, _| f32::from_bits(x.to_bits() & 0x7fff_ffff));
-        same(a.sqrt(), &|x, _| x.sqrt());
+        made(a.sqrt(), &|x, _| x.sqrt());
         same(a.max(b), &|x, y| if x > y { x } else { y });
         same(a.min(b), &|x, y| if x < y { x } else { y });
         let mask = |m: M8, f: &dyn Fn(f32, f32) -> bool| {

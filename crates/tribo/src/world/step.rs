@@ -57,6 +57,8 @@ impl World {
     fn run_step(&mut self, dt: f32, parallel: bool) {
         let mut total = Stopwatch::start();
         let mut lap = Stopwatch::start();
+        // (No refit is pending here, unless a step was cut short: see finalize below.)
+        self.broad_phase.refit();
         self.reorder_contacts();
         self.update_pairs();
         self.profile.pairs = lap.lap();
@@ -197,7 +199,7 @@ impl World {
     /// prune over the tree's boxes (`SweepPrune`: sorted along one axis in bands across
     /// it, each box tested against those of its bands starting inside its interval;
     /// tumbler's pairs stage 0.556 → 0.27 ms), or,
-    /// where the boxes are lined up so that the sweep would test too many, from one walk of
+    /// where the boxes are crowded on both axes so that the sweep would test too many, from one walk of
     /// the tree's [`FlatTree`] copy against itself; the same pairs either way. A pair with
     /// a contact is found in the pair table without reading either shape's record.
     fn moving_tree_pairs(&mut self, moved: &[u32], new_pairs: &mut Vec<u64>) {
