@@ -1539,6 +1539,17 @@ mod tests {
         Aabb::new(Vec2::new(x, y), Vec2::new(x + w, y + h))
     }
 
+    /// `old` moved by up to 0.5 m (kept in place by a near move), or, one time in `far`, a
+    /// new random box (reinserted).
+    fn nudged_or_new(r: &mut Lcg, old: Aabb, far: usize) -> Aabb {
+        if r.below(far) != 0 {
+            let d = Vec2::new(r.range(-0.5, 0.5), r.range(-0.5, 0.5));
+            Aabb::new(old.min + d, old.max + d)
+        } else {
+            random_box(r, 100.0, 8.0)
+        }
+    }
+
     fn query_sorted(t: &DynamicTree, q: Aabb, mask: u64) -> Vec<u32> {
         let mut v = Vec::new();
         t.query(q, mask, |id, ud| {
@@ -1595,13 +1606,7 @@ mod tests {
                     // A small move (kept in place, ancestors refitted) or a far one
                     // (reinserted).
                     let k = r.below(live.len());
-                    let old = live[k].1;
-                    let b = if r.below(2) == 0 {
-                        let d = Vec2::new(r.range(-0.5, 0.5), r.range(-0.5, 0.5));
-                        Aabb::new(old.min + d, old.max + d)
-                    } else {
-                        random_box(&mut r, 100.0, 8.0)
-                    };
+                    let b = nudged_or_new(&mut r, live[k].1, 2);
                     assert!(t.move_proxy_near(live[k].0, b));
                     live[k].1 = b;
                 } else if op < 8 {
@@ -1626,13 +1631,7 @@ mod tests {
             if !live.is_empty() {
                 for _ in 0..40 {
                     let k = r.below(live.len());
-                    let old = live[k].1;
-                    let b = if r.below(4) != 0 {
-                        let d = Vec2::new(r.range(-0.5, 0.5), r.range(-0.5, 0.5));
-                        Aabb::new(old.min + d, old.max + d)
-                    } else {
-                        random_box(&mut r, 100.0, 8.0)
-                    };
+                    let b = nudged_or_new(&mut r, live[k].1, 4);
                     assert!(t.move_proxy_deferred(live[k].0, b));
                     live[k].1 = b;
                 }

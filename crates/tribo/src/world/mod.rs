@@ -1441,6 +1441,15 @@ mod tests {
         (w, ground)
     }
 
+    /// The shape pairs of a world's contacts, in contact order.
+    fn shape_pairs(w: &World) -> Vec<(u32, u32)> {
+        w.contacts
+            .iter()
+            .flatten()
+            .map(|c| (c.shape_a.index, c.shape_b.index))
+            .collect()
+    }
+
     /// A pyramid of `rows` rows of 1 m boxes on the ground, sleep off.
     fn pyramid(rows: usize) -> World {
         let (mut w, ground) = sleepless_with_ground();
@@ -1581,14 +1590,7 @@ mod tests {
             b.step(1.0 / 60.0).unwrap();
         }
         assert!(a.reordered_at.is_some(), "the pyramid's contacts were renumbered");
-        let pairs = |w: &World| -> Vec<(u32, u32)> {
-            w.contacts
-                .iter()
-                .flatten()
-                .map(|c| (c.shape_a.index, c.shape_b.index))
-                .collect()
-        };
-        let (pa, pb) = (pairs(&a), pairs(&b));
+        let (pa, pb) = (shape_pairs(&a), shape_pairs(&b));
         assert_ne!(pa, pb, "renumbered: the contacts come in another order");
         let sorted = |mut p: Vec<(u32, u32)>| {
             p.sort_unstable();
@@ -1917,15 +1919,8 @@ mod tests {
             "the first sweep gave up, the next backed off"
         );
         assert_eq!(a.broad_phase.walks, 3);
-        let pairs = |w: &World| -> Vec<(u32, u32)> {
-            w.contacts
-                .iter()
-                .flatten()
-                .map(|c| (c.shape_a.index, c.shape_b.index))
-                .collect()
-        };
-        assert!(pairs(&a).len() > 300 * 299 / 4, "the heap's boxes overlap");
-        assert_eq!(pairs(&a), pairs(&b));
+        assert!(shape_pairs(&a).len() > 300 * 299 / 4, "the heap's boxes overlap");
+        assert_eq!(shape_pairs(&a), shape_pairs(&b));
         for ((_, x), (_, y)) in a.bodies.iter().zip(b.bodies.iter()) {
             assert_eq!((x.xf, x.v, x.w), (y.xf, y.v, y.w));
         }
