@@ -27,11 +27,11 @@ use crate::math::wide::{F4, LANES4};
 
 /// A sweep gives up (and the caller walks the tree instead) past this many candidate
 /// tests per box on average (a box tested in each band it is listed in, each time
-/// counted, in chunks of four): with the boxes crowded on both axes (many boxes spawned on one spot,
-/// say) each box's interval in its band holds most of the others, and the tree's walk,
-/// which costs per pair found, is then the cheaper. At the limit the sweep's tests have
-/// cost about what the walk costs in a pile (tumbler: ~17 tests a box; ~57 before the
-/// bands, when a sweep along x met the pile's whole height).
+/// counted, in chunks of four): with the boxes crowded on both axes (many boxes spawned
+/// on one spot, say) each box's interval in its band holds most of the others, and the
+/// tree's walk, which costs per pair found, is then the cheaper. This many tests cost
+/// about what the walk costs in a pile; the tumbler's pile needs ~17 a box (~57 before
+/// the bands, when a sweep along x met the pile's whole height).
 const MAX_TESTS_PER_BOX: usize = 128;
 
 /// The height of a band across the sweep axis, in mean box extents on that axis (see
@@ -292,10 +292,11 @@ impl SweepPrune {
 /// Step 3 of [`SweepPrune::moved_pairs`] over its sorted arrays (`[lo, hi, cross_lo,
 /// cross_hi]`, each band's entries followed by a chunk of padding that no interval holds):
 /// box i against the boxes of its band after it that start inside its interval, a chunk
-/// of them at a time, up to the first chunk with one starting past it. Each of those also ends after box i
-/// starts (it starts no earlier and a box ends no earlier than it starts), so only the
-/// cross axis is left to test, four boxes in one comparison; few candidates hit (tumbler:
-/// one in twelve), so the hits are taken from the comparison's bits. False (with pairs
+/// of them at a time, up to the first chunk with one starting past it. Each of those also
+/// ends after box i starts (it starts no earlier and a box ends no earlier than it
+/// starts), so only the cross axis is left to test, four boxes in one comparison; most
+/// candidates miss (tumbler: two in three), so the hits are taken from the comparison's
+/// bits. False (with pairs
 /// pushed) past `budget` tests. A function of its own, on slices: inlined into the
 /// step, its loop kept its values on the stack (the sweep took 0.24 ms of tumbler's step).
 #[inline(never)]

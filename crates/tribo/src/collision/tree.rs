@@ -2,9 +2,9 @@
 //!
 //! Pipeline stage: broad phase. Every shape proxy is a leaf holding a (caller-fattened) box;
 //! internal nodes hold the union of their two children (except between
-//! `DynamicTree::move_proxy_deferred` and `DynamicTree::refit_all`, when no query may come). Queries and ray casts walk the tree
-//! with an explicit stack and prune whole subtrees whose box misses or whose category union
-//! does not match the mask.
+//! `DynamicTree::move_proxy_deferred` and `DynamicTree::refit_all`, when no query may
+//! come). Queries and ray casts walk the tree with an explicit stack and prune whole
+//! subtrees whose box misses or whose category union does not match the mask.
 //!
 //! Ideas (from the literature, re-implemented here):
 //! * Fat AABBs and incremental insert/remove/move, as in Box2D's `b2DynamicTree`

@@ -198,10 +198,10 @@ impl World {
     /// `new_pairs` (see [`World::update_pairs`]): the overlapping pairs from a sweep and
     /// prune over the tree's boxes (`SweepPrune`: sorted along one axis in bands across
     /// it, each box tested against those of its bands starting inside its interval;
-    /// tumbler's pairs stage 0.556 → 0.27 ms), or,
-    /// where the boxes are crowded on both axes so that the sweep would test too many, from one walk of
-    /// the tree's [`FlatTree`] copy against itself; the same pairs either way. A pair with
-    /// a contact is found in the pair table without reading either shape's record.
+    /// tumbler's pairs stage 0.556 → 0.27 ms), or, where the boxes are crowded on both
+    /// axes so that the sweep would test too many, from one walk of the tree's
+    /// [`FlatTree`] copy against itself; the same pairs either way. A pair with a contact
+    /// is found in the pair table without reading either shape's record.
     fn moving_tree_pairs(&mut self, moved: &[u32], new_pairs: &mut Vec<u64>) {
         let mut mark = core::mem::take(&mut self.broad_phase.moved_mark);
         mark.clear();
