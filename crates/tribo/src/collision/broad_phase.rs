@@ -104,15 +104,21 @@ impl BroadPhase {
     /// `few[k]`: tree `k` takes few queries whatever `queries` says (no copy made for it).
     pub fn prepare_queries(&mut self, queries: usize, few: [bool; 2]) -> [bool; 2] {
         let mut use_flat = [false; 2];
-        for (k, (tree, flat)) in self.trees.iter().zip(self.flat.iter_mut()).enumerate() {
-            use_flat[k] = flat.is_copy_of(tree);
-            let many = queries * FLAT_QUERY_SHARE >= tree.proxy_count() && !few[k];
-            if !use_flat[k] && many && tree.proxy_count() > 0 {
-                tree.flatten_into(flat);
-                use_flat[k] = true;
+        for k in 0..2 {
+            let count = self.trees[k].proxy_count();
+            if queries * FLAT_QUERY_SHARE >= count && !few[k] && count > 0 {
+                self.make_flat(k);
             }
+            use_flat[k] = self.flat[k].is_copy_of(&self.trees[k]);
         }
         use_flat
+    }
+
+    /// Makes tree `k`'s [`FlatTree`] copy current (kept when it is).
+    pub fn make_flat(&mut self, k: usize) {
+        if !self.flat[k].is_copy_of(&self.trees[k]) {
+            self.trees[k].flatten_into(&mut self.flat[k]);
+        }
     }
 
     /// Inserts a proxy for a shape; returns its proxy id.

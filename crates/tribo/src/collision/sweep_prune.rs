@@ -321,8 +321,10 @@ fn sweep_sorted(
     let n = len.saturating_sub(CHUNK);
     // A box's hits (places in sweep order), written in the loop, which then calls nothing
     // (a call, even a push's rare growth, made the loop keep its vectors on the stack).
-    hits.clear();
-    hits.resize(len, 0);
+    // (Each place is written before it is read: no clearing.)
+    if hits.len() < len {
+        hits.resize(len, 0);
+    }
     let mut tests = 0usize;
     for i in 0..n {
         let (Some(&end), Some(&c_lo), Some(&c_hi), Some(&d), Some(&m), Some(&band)) = (

@@ -281,6 +281,12 @@ impl DynamicTree {
     /// tight. A proxy that left its neighbourhood is reinserted. Returns false when `proxy`
     /// is not a live proxy or `aabb` is not valid.
     pub fn move_proxy_near(&mut self, proxy: u32, aabb: Aabb) -> bool {
+        self.move_near(proxy, aabb, false)
+    }
+
+    /// [`move_proxy_near`](Self::move_proxy_near), its ancestors refitted at once or, with
+    /// `defer`, left to [`refit_all`](Self::refit_all).
+    fn move_near(&mut self, proxy: u32, aabb: Aabb, defer: bool) -> bool {
         self.revision += 1;
         if !self.is_proxy(proxy) || !aabb.is_valid() {
             return false;
@@ -308,16 +314,26 @@ impl DynamicTree {
             return self.move_proxy(proxy, aabb);
         }
         self.nodes[proxy as usize].aabb = aabb;
-        let mut i = parent;
+        if defer {
+            self.unfitted = true;
+            self.deferred.push(proxy);
+        } else {
+            self.refit_from(parent);
+        }
+        true
+    }
+
+    /// Refits node `i` and its ancestors, up to the first one its refit leaves unchanged
+    /// (every further ancestor is then unchanged too).
+    fn refit_from(&mut self, mut i: u32) {
         while i != NULL_NODE {
             let before = self.nodes[i as usize].aabb;
             self.refit(i);
             if self.nodes[i as usize].aabb.same(before) {
-                break; // every further ancestor is unchanged too
+                break;
             }
             i = self.nodes[i as usize].parent;
         }
-        true
     }
 
     /// [`move_proxy_near`](Self::move_proxy_near) for one of many proxies moved in a row:
@@ -328,23 +344,7 @@ impl DynamicTree {
     /// (its search reads boxes that may be stale: a worse place, never a wrong tree, once
     /// refitted). Returns false when `proxy` is not a live proxy or `aabb` is not valid.
     pub fn move_proxy_deferred(&mut self, proxy: u32, aabb: Aabb) -> bool {
-        self.revision += 1;
-        if !self.is_proxy(proxy) || !aabb.is_valid() {
-            return false;
-        }
-        let parent = self.nodes[proxy as usize].parent;
-        if parent != NULL_NODE {
-            let p = &self.nodes[parent as usize];
-            let sibling = p.child1 ^ p.child2 ^ proxy;
-            let reach = (aabb.max - aabb.min).x.max((aabb.max - aabb.min).y);
-            if !aabb.overlaps(self.nodes[sibling as usize].aabb.expand(reach)) {
-                return self.move_proxy(proxy, aabb);
-            }
-            self.unfitted = true;
-            self.deferred.push(proxy);
-        }
-        self.nodes[proxy as usize].aabb = aabb;
-        true
+        self.move_near(proxy, aabb, true)
     }
 
     /// Makes every internal node's box, category bits and height those of its children
@@ -362,24 +362,18 @@ impl DynamicTree {
         self.unfitted = false;
         self.revision += 1;
         let mut deferred = core::mem::take(&mut self.deferred);
-        if deferred.len() * FEW_DEFERRED < self.proxy_count {
+        let few = deferred.len() * FEW_DEFERRED < self.proxy_count;
+        if few {
             for &leaf in &deferred {
-                let mut i = self.nodes.get(leaf as usize).map_or(NULL_NODE, |n| n.parent);
-                while let Some(n) = self.nodes.get(i as usize) {
-                    let before = n.aabb;
-                    self.refit(i);
-                    if self.nodes[i as usize].aabb.same(before) {
-                        break; // every further ancestor is unchanged too
-                    }
-                    i = self.nodes[i as usize].parent;
-                }
+                let parent = self.nodes.get(leaf as usize).map_or(NULL_NODE, |n| n.parent);
+                self.refit_from(parent);
             }
-            deferred.clear();
-            self.deferred = deferred;
-            return;
         }
         deferred.clear();
         self.deferred = deferred;
+        if few {
+            return;
+        }
         let (mut order, mut stack) = (
             core::mem::take(&mut self.refit_order),
             core::mem::take(&mut self.refit_stack),

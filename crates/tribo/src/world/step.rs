@@ -223,9 +223,7 @@ impl World {
         if !swept {
             keys.clear();
             bp.walks += 1;
-            if !bp.flat[moving].is_copy_of(&bp.trees[moving]) {
-                bp.trees[moving].flatten_into(&mut bp.flat[moving]);
-            }
+            bp.make_flat(moving);
             bp.flat[moving].self_pairs(|a, b| {
                 let moved = |s: u64| mark.get(s as usize).copied().unwrap_or(false);
                 if moved(a) || moved(b) {
