@@ -759,3 +759,59 @@ fn sleeping_block_wakes_from_the_impact_alike_on_any_worker_count() {
     let (three, ..) = run(3);
     assert!(one == three, "three workers differ from one");
 }
+
+/// A box held by static friction on a tilted floor (gravity tilted by θ = 20°, μ = 0.8 >
+/// tan θ) reports, summed over its contact points, the impulses that hold it each step:
+/// normal m·g·cos θ·dt and friction m·g·sin θ·dt (Newton at rest: the contact impulse
+/// cancels gravity's). Tolerance 1 %: at rest the box's velocity changes by well under 0.1 %
+/// of g·dt per step (the soft contact's residual). Its points stick and slip at under the
+/// stick speed. Once the box sleeps its contacts are no longer solved, and they keep
+/// reporting the impulses of their last solved step.
+#[test]
+fn a_resting_box_reports_the_impulses_that_hold_it_also_asleep() {
+    let theta = 20f32.to_radians();
+    let g = 9.81;
+    let mut world = World::new(WorldDef {
+        gravity: Vec2::new(g * theta.sin(), -g * theta.cos()),
+        ..WorldDef::default()
+    })
+    .unwrap();
+    let floor = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
+    let grip = ShapeDef {
+        material: Material::with_friction(0.8),
+        ..ShapeDef::default()
+    };
+    world
+        .create_shape(floor, &grip, &Shape::Polygon(Polygon::new_box(50.0, 1.0).unwrap()))
+        .unwrap();
+    let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 0.5))).unwrap();
+    world.create_shape(b, &grip, &unit_box()).unwrap();
+    let m = world.body_mass(b).unwrap();
+    let sums = |world: &World| {
+        let contacts = world.body_contacts(b).unwrap();
+        assert_eq!(contacts.len(), 1, "one contact, with the floor");
+        let points = contacts[0].points();
+        assert_eq!(points.len(), 2, "a face contact");
+        assert!(points.iter().all(|p| p.state == tribo::FrictionState::Stick && p.slip_speed < 0.01));
+        let n: f32 = points.iter().map(|p| p.normal_impulse).sum();
+        let t: f32 = points.iter().map(|p| p.friction_impulse).sum();
+        (n, t)
+    };
+    for _ in 0..60 {
+        world.step(DT).unwrap();
+    }
+    let (n, t) = sums(&world);
+    let (want_n, want_t) = (m * g * theta.cos() * DT, m * g * theta.sin() * DT);
+    assert!((n - want_n).abs() < 0.01 * want_n, "normal {n} N·s, expected {want_n}");
+    assert!((t.abs() - want_t).abs() < 0.01 * want_t, "friction {t} N·s, expected ±{want_t}");
+    let mut steps = 0;
+    while world.body_is_awake(b).unwrap() {
+        world.step(DT).unwrap();
+        steps += 1;
+        assert!(steps < 600, "the box falls asleep");
+    }
+    let asleep = sums(&world);
+    world.step(DT).unwrap();
+    assert_eq!(sums(&world), asleep, "a sleeping contact keeps its last step's impulses");
+    assert!((asleep.0 - want_n).abs() < 0.01 * want_n);
+}

@@ -23,13 +23,11 @@ pub enum FrictionState {
 
 /// What persists for one manifold point between steps (matched by feature id).
 ///
-/// `repr(C)`, the eight floats first in the order of [`PointState::set_stored`]: the
-/// impulse store writes them as two 16-byte rows per point, straight from the transpose
-/// of its lanes. The first row holds what the next step's solver input reads
-/// (`ContactInput::fill`: the impulses, drift and preload), the second the step's sums,
-/// which [`Contact::recycle`] zeroes just before that read: with the sums in the first row
-/// the input's 16-byte load spanned the recycle's smaller stores and could not be
-/// forwarded from them (it waited for them to reach the cache, four times a contact).
+/// `repr(C)`, the four floats first in the order of [`PointState::set_stored`]: the
+/// impulse store writes them as one 16-byte row per point, straight from the transpose of
+/// its lanes; they are what the next step's solver input reads (`ContactInput::fill`).
+/// What the step applied (its sums, the slip speed) is reported, never read back: it lives
+/// apart, in [`PointSums`], so the store writes one cache line of each contact record.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C)]
 pub(crate) struct PointState {
@@ -43,14 +41,6 @@ pub(crate) struct PointState {
     /// Normal impulse per substep [N·s] the soft contact relaxes towards (a slowly
     /// tracking average of the manifold's load, so a steady load needs no deflection).
     pub preload: f32,
-    /// Sum over the step's substeps of the normal impulse [N·s] (what the step applied).
-    pub total_normal_impulse: f32,
-    /// Sum over the step's substeps of the friction impulse [N·s].
-    pub total_tangent_impulse: f32,
-    /// Largest normal impulse of any substep [N·s]; > 0 means the point carried load.
-    pub max_normal_impulse: f32,
-    /// Relative tangential speed at the end of the step [m/s] (surface speed removed).
-    pub slip_speed: f32,
     /// Stick or slip.
     pub state: FrictionState,
     /// True until the point has been through one solver step.
@@ -59,25 +49,60 @@ pub(crate) struct PointState {
 
 impl PointState {
     /// Sets what the impulse store writes: `carried` = (normal [N·s], tangent [N·s], drift
-    /// [m], preload [N·s]), `sums` = (total normal [N·s], total tangent [N·s], max normal
-    /// [N·s], slip speed [m/s]), the friction state, and `fresh` off. Field by field in
-    /// layout order, so each row compiles to one 16-byte store.
+    /// [m], preload [N·s]), the friction state, and `fresh` off. Field by field in layout
+    /// order, so the row compiles to one 16-byte store.
     #[inline(always)]
-    pub fn set_stored(&mut self, carried: [f32; 4], sums: [f32; 4], state: FrictionState) {
+    pub fn set_stored(&mut self, carried: [f32; 4], state: FrictionState) {
         let [normal, tangent, drift, preload] = carried;
-        let [total_normal, total_tangent, max, slip_speed] = sums;
         self.normal_impulse = normal;
         self.tangent_impulse = tangent;
         self.drift = drift;
         self.preload = preload;
-        self.total_normal_impulse = total_normal;
-        self.total_tangent_impulse = total_tangent;
-        self.max_normal_impulse = max;
-        self.slip_speed = slip_speed;
         self.state = state;
         self.fresh = false;
     }
 }
+
+/// What the last solved step did at one manifold point, for contact reports
+/// (`World::contacts`; the solver never reads it back). Kept per contact slot in
+/// `World::contact_sums`, apart from the [`Contact`] records: the impulse store writes it
+/// in the solver's layout order (the order of the contact slots), a dense stream the
+/// hardware prefetches, and one cache line of each record rather than two (large_pyramid:
+/// the store's time had gone into waiting for the records' second lines). The store writes
+/// a solved contact's sums; a touching contact the solver did not take gets zeros; a
+/// sleeping one keeps those of its last solved step.
+///
+/// `repr(C)`, the order of the store's second row per point.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
+pub(crate) struct PointSums {
+    /// Sum over the step's substeps of the normal impulse [N·s] (what the step applied).
+    pub total_normal_impulse: f32,
+    /// Sum over the step's substeps of the friction impulse [N·s].
+    pub total_tangent_impulse: f32,
+    /// Largest normal impulse of any substep [N·s]; > 0 means the point carried load.
+    pub max_normal_impulse: f32,
+    /// Relative tangential speed at the end of the step [m/s] (surface speed removed).
+    pub slip_speed: f32,
+}
+
+impl PointSums {
+    /// The sums from the store's row (total normal [N·s], total tangent [N·s], max normal
+    /// [N·s], slip speed [m/s]).
+    #[inline(always)]
+    pub fn from_row(row: [f32; 4]) -> PointSums {
+        let [total_normal_impulse, total_tangent_impulse, max_normal_impulse, slip_speed] = row;
+        PointSums {
+            total_normal_impulse,
+            total_tangent_impulse,
+            max_normal_impulse,
+            slip_speed,
+        }
+    }
+}
+
+/// A contact's [`PointSums`], one per manifold point.
+pub(crate) type ContactSums = [PointSums; MAX_MANIFOLD_POINTS];
 
 /// [`Contact::colour`] of a contact not yet solved, or solved in the overflow list.
 pub(crate) const NO_COLOUR: u8 = u8::MAX;
@@ -87,7 +112,7 @@ pub(crate) const NO_COLOUR: u8 = u8::MAX;
 /// Laid out by use (`repr(C)`, whole cache lines): the passes in contact order that touch
 /// only a little of each record — the awake test before the narrow phase, the impulse
 /// store — find what they need (the liveness flag, `touching`, the bodies, the point
-/// states) in the first two lines; the recycling basis and the shape ids, read only by the
+/// states) in the first line; the recycling basis and the shape ids, read only by the
 /// narrow phase and events, come last.
 #[derive(Clone, Debug)]
 #[repr(C, align(64))]
@@ -119,6 +144,10 @@ pub(crate) struct Contact {
 }
 
 const _: () = assert!(core::mem::size_of::<Contact>() == 320);
+// Everything the impulse store writes (colour, rolling impulse, the point states) lies in
+// the record's first cache line.
+const _: () =
+    assert!(core::mem::offset_of!(Contact, points) + core::mem::size_of::<[PointState; MAX_MANIFOLD_POINTS]>() <= 64);
 
 /// What a contact keeps of its last full collision to skip the next: for a touching pair
 /// its poses then, which its first recycle turns into the recycling basis, or the distance
@@ -271,13 +300,7 @@ impl Contact {
             let id = self.manifold.points[i].id;
             let matched = (0..old_manifold.count).find(|&j| old_manifold.points[j].id == id);
             self.points[i] = match matched {
-                Some(j) => {
-                    let mut p = old_points[j];
-                    p.total_normal_impulse = 0.0;
-                    p.total_tangent_impulse = 0.0;
-                    p.max_normal_impulse = 0.0;
-                    p
-                }
+                Some(j) => old_points[j],
                 None => PointState {
                     fresh: true,
                     ..PointState::default()
@@ -431,10 +454,6 @@ impl Contact {
             mp.anchor_a = mp.point - xf_a.p;
             mp.anchor_b = mp.point - xf_b.p;
             mp.separation = (surface_b - surface_a).dot(n);
-            let p = &mut self.points[i];
-            p.total_normal_impulse = 0.0;
-            p.total_tangent_impulse = 0.0;
-            p.max_normal_impulse = 0.0;
         }
         true
     }

@@ -34,7 +34,7 @@
 
 use super::contact_wide::{self, StoredContact, WideCold, WideContact, WideDerived, WideHead, COLORS, DYNAMIC_COLORS};
 use super::wide::{array_of, LANES};
-use crate::collision::contact::{Contact, NO_COLOUR};
+use crate::collision::contact::{Contact, ContactSums, NO_COLOUR};
 use crate::math::Vec2;
 use crate::solver::candidates::{
     mass_ratio, Candidate, Candidates, ColourKey, COLOUR_FLAGS, FAST, FRESH, KEY_DYNAMIC_A, KEY_DYNAMIC_B, KEY_RATIO,
@@ -781,8 +781,9 @@ impl ContactSolver {
     }
 
     /// Writes every constraint's impulses and friction state back into its contact
-    /// (`contacts` is the world's contact list): each group computes what its lanes store
-    /// and writes it straight into their contacts (their first two cache lines asked for a
+    /// (`contacts` is the world's contact list) and its reported sums into `sums` (the
+    /// world's `contact_sums`, one per contact slot): each group computes what its lanes
+    /// store and writes it straight into their contacts (their first cache line asked for a
     /// few groups ahead), then the overflow constraints store theirs.
     ///
     /// With threads, the groups are cut into one run per thread, and the contact list at
@@ -799,7 +800,13 @@ impl ContactSolver {
     /// into eight runs large_pyramid had 1 509 contacts a step to write after, serially,
     /// against 85 with two runs (store +30 % on two threads).
     #[super::lane_fn]
-    pub fn store<S: StateRead + Sync>(&mut self, ctx: &StepContext, states: &[S], contacts: &mut [Option<Contact>]) {
+    pub fn store<S: StateRead + Sync>(
+        &mut self,
+        ctx: &StepContext,
+        states: &[S],
+        contacts: &mut [Option<Contact>],
+        sums: &mut [ContactSums],
+    ) {
         let groups = self.head.len();
         let tasks = if ctx.parallel {
             rayon::current_num_threads().min(groups / STORE_MIN_GROUPS).max(1)
@@ -821,16 +828,19 @@ impl ContactSolver {
         }
         let mut strays = Vec::new();
         if starts.len() == 1 {
-            self.store_groups(ctx, states, 0..groups, contacts, 0, &mut strays);
+            self.store_groups(ctx, states, 0..groups, (contacts, sums), 0, &mut strays);
         } else {
             let mut runs = Vec::with_capacity(starts.len());
             let mut rest: &mut [Option<Contact>] = &mut *contacts;
+            let mut rest_sums: &mut [ContactSums] = &mut *sums;
             for (k, &(g, at)) in starts.iter().enumerate() {
                 let (end_group, end_at) = starts.get(k + 1).copied().unwrap_or((groups, usize::MAX));
                 let len = end_at.saturating_sub(at).min(rest.len());
                 let (mine, tail) = core::mem::take(&mut rest).split_at_mut(len);
-                runs.push((g..end_group, at, mine));
+                let (mine_sums, tail_sums) = core::mem::take(&mut rest_sums).split_at_mut(len.min(rest_sums.len()));
+                runs.push((g..end_group, at, (mine, mine_sums)));
                 rest = tail;
+                rest_sums = tail_sums;
             }
             let this = &*self;
             let mut kept: Vec<Vec<(u32, u8, StoredContact)>> = vec![Vec::new(); runs.len()];
@@ -844,14 +854,15 @@ impl ContactSolver {
             strays.extend(kept.into_iter().flatten());
         }
         for (contact, colour, stored) in strays {
-            if let Some(Some(c)) = contacts.get_mut(contact as usize) {
-                stored.write_into(c);
+            if let (Some(Some(c)), Some(sum)) = (contacts.get_mut(contact as usize), sums.get_mut(contact as usize)) {
+                stored.write_into(c, sum);
                 c.colour = colour;
             }
         }
         for oc in &self.overflow {
-            if let Some(Some(c)) = contacts.get_mut(oc.contact as usize) {
-                store_impulses(oc, c, states, ctx);
+            let at = oc.contact as usize;
+            if let (Some(Some(c)), Some(sum)) = (contacts.get_mut(at), sums.get_mut(at)) {
+                store_impulses(oc, c, sum, states, ctx);
                 c.colour = NO_COLOUR;
             }
         }
@@ -859,16 +870,16 @@ impl ContactSolver {
 }
 
 impl ContactSolver {
-    /// The store of the groups in `range`, into `contacts`, the part of the contact list
-    /// from contact `base` on; a lane whose contact lies outside it goes to `strays`
-    /// (contact, colour, what it stores).
+    /// The store of the groups in `range`, into `contacts` and `sums`, the parts of the
+    /// contact list and of the sums from contact `base` on (of the same length); a lane
+    /// whose contact lies outside them goes to `strays` (contact, colour, what it stores).
     #[super::lane_fn]
     fn store_groups<S: StateRead>(
         &self,
         ctx: &StepContext,
         states: &[S],
         range: core::ops::Range<usize>,
-        contacts: &mut [Option<Contact>],
+        (contacts, sums): (&mut [Option<Contact>], &mut [ContactSums]),
         base: usize,
         strays: &mut Vec<(u32, u8, StoredContact)>,
     ) {
@@ -886,7 +897,7 @@ impl ContactSolver {
                 for (&cand, &contact) in ahead.iter().zip(&ahead_cold.contact) {
                     if cand != u32::MAX {
                         if let Some(c) = contacts.get(at(contact)) {
-                            crate::solver::prefetch_lines(c, 2);
+                            crate::solver::prefetch_lines(c, 1);
                         }
                     }
                 }
@@ -899,13 +910,13 @@ impl ContactSolver {
                 if cand == u32::MAX {
                     continue; // an empty lane
                 }
-                match contacts.get_mut(at(contact)) {
-                    Some(Some(c)) => {
-                        out.write_into(l, c);
+                match (contacts.get_mut(at(contact)), sums.get_mut(at(contact))) {
+                    (Some(Some(c)), Some(sum)) => {
+                        out.write_into(l, c, sum);
                         c.colour = colour;
                     }
-                    Some(None) => {}
-                    None => strays.push((contact, colour, out.lane(l))),
+                    (Some(None), _) => {}
+                    _ => strays.push((contact, colour, out.lane(l))),
                 }
             }
         }
@@ -1299,9 +1310,15 @@ impl crate::solver::WideContacts for ContactSolver {
         unsafe { self.build(ctx, states, sims, candidates, loaded) }
     }
 
-    fn store_step<S: StateRead + Sync>(&mut self, ctx: &StepContext, states: &[S], contacts: &mut [Option<Contact>]) {
+    fn store_step<S: StateRead + Sync>(
+        &mut self,
+        ctx: &StepContext,
+        states: &[S],
+        contacts: &mut [Option<Contact>],
+        sums: &mut [ContactSums],
+    ) {
         // SAFETY: see `impl ConstraintSet for ContactSolver`.
-        unsafe { self.store(ctx, states, contacts) }
+        unsafe { self.store(ctx, states, contacts, sums) }
     }
 }
 

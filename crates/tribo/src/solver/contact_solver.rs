@@ -57,7 +57,7 @@
 //! block solver in soft form), so one iteration is exact within the manifold.
 
 use super::{BodyState, Softness, StateCell, StateRead, StepContext};
-use crate::collision::contact::{Contact, FrictionState};
+use crate::collision::contact::{Contact, ContactSums, FrictionState};
 use crate::math::Vec2;
 
 /// Solver data of one manifold point.
@@ -1423,11 +1423,12 @@ fn solve_rolling(cc: &mut ContactConstraint, a: &mut BodyState, b: &mut BodyStat
     b.w += cc.inv_i_b * delta;
 }
 
-/// Writes impulses back into the contact and runs the stick/slip transitions
-/// (store stage). `states` are the end-of-step states.
+/// Writes impulses back into the contact and its reported sums (`sums`), and runs the
+/// stick/slip transitions (store stage). `states` are the end-of-step states.
 pub(crate) fn store_impulses<S: StateRead>(
     cc: &ContactConstraint,
     contact: &mut Contact,
+    sums: &mut ContactSums,
     states: &[S],
     ctx: &StepContext,
 ) {
@@ -1445,19 +1446,23 @@ pub(crate) fn store_impulses<S: StateRead>(
     let sum_total_t: f32 = cc.points[..cc.count].iter().map(|p| p.total_tangent_impulse).sum();
     let sum_total_n: f32 = cc.points[..cc.count].iter().map(|p| p.total_normal_impulse).sum();
     let frame = RowFrame::new(cc, &a, &b, t);
-    for (cp, ps) in cc.points[..cc.count].iter().zip(contact.points.iter_mut()) {
+    for ((cp, ps), sum) in cc.points[..cc.count]
+        .iter()
+        .zip(contact.points.iter_mut())
+        .zip(sums.iter_mut())
+    {
         ps.normal_impulse = cp.normal_impulse;
         ps.tangent_impulse = cp.tangent_impulse;
-        ps.total_normal_impulse = cp.total_normal_impulse;
+        sum.total_normal_impulse = cp.total_normal_impulse;
         // A face contact's friction is one patch row (split evenly inside the solver, which
         // is the same as acting at the middle); report it split in proportion to the
         // points' normal impulses, so each point shows |f| ≤ μ·n like the patch does.
-        ps.total_tangent_impulse = if cc.count == 2 && sum_total_n > 0.0 {
+        sum.total_tangent_impulse = if cc.count == 2 && sum_total_n > 0.0 {
             sum_total_t * cp.total_normal_impulse / sum_total_n
         } else {
             cp.total_tangent_impulse
         };
-        ps.max_normal_impulse = cp.max_normal_impulse;
+        sum.max_normal_impulse = cp.max_normal_impulse;
         let bounced = bounces(
             cc.restitution,
             cc.restitution_threshold,
@@ -1468,13 +1473,13 @@ pub(crate) fn store_impulses<S: StateRead>(
         ps.fresh = false;
         let (m, disp) = frame.point(&a, &b, cp.r_a, cp.r_b);
         let vt = row_speed(&a, &b, t, m) - cc.tangent_speed;
-        ps.slip_speed = vt.abs();
+        sum.slip_speed = vt.abs();
         let loaded = cp.max_normal_impulse > 0.0;
         let mut stick = cp.stick;
         if loaded {
-            if stick && patch_saturated && ps.slip_speed > ctx.stick_speed {
+            if stick && patch_saturated && sum.slip_speed > ctx.stick_speed {
                 stick = false;
-            } else if !stick && ps.slip_speed < ctx.stick_speed {
+            } else if !stick && sum.slip_speed < ctx.stick_speed {
                 stick = true;
             }
         }

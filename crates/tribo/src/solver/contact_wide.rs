@@ -34,7 +34,7 @@
 //! contact is solved one way for a whole step.
 
 use super::wide::{array_of, lanes_to_rows, rows_to_lanes, F4, FL, LANES, ML, VL};
-use crate::collision::contact::{Contact, FrictionState, PointState};
+use crate::collision::contact::{Contact, ContactSums, FrictionState, PointState, PointSums};
 use crate::math::Vec2;
 use crate::solver::contact_solver::{
     fresh_point_sticks, kinetic_energy_of, ConstraintBodies, ConstraintPoint, ContactConstraint, ContactInput,
@@ -1093,36 +1093,46 @@ fn wide_shift_cap2(ma: FL, ia: FL, mb: FL, ib: FL) -> FL {
     rho2.lt(max).select(FL::splat(0.25) * rho2, max)
 }
 
-/// What the store writes into one contact: its points' persistent states and the rolling
-/// impulse (`contact_solver::store_impulses`, computed from a lane).
+/// What the store writes into one contact: its points' persistent states, the rolling
+/// impulse and its points' reported sums (`contact_solver::store_impulses`, computed from a
+/// lane).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct StoredContact {
     pub points: [PointState; 2],
+    pub sums: ContactSums,
     pub rolling_impulse: f32,
     /// Points written (the manifold's count).
     pub count: u8,
 }
 
 impl StoredContact {
-    /// Writes what it holds into its contact (the manifold's points and the rolling
-    /// impulse).
+    /// Writes what it holds into its contact and its sums (the manifold's points and the
+    /// rolling impulse).
     #[inline]
     #[super::lane_fn]
-    pub(crate) fn write_into(&self, c: &mut Contact) {
-        write_stored(c, self.count, self.rolling_impulse, |i, ps| *ps = self.points[i]);
+    pub(crate) fn write_into(&self, c: &mut Contact, sums: &mut ContactSums) {
+        write_stored(c, sums, self.count, self.rolling_impulse, |i, ps, sum| {
+            (*ps, *sum) = (self.points[i], self.sums[i])
+        });
     }
 }
 
-/// Writes a contact's stored states: `set(i, point)` sets point `i` in place for each of
-/// its `count` points (fixed-size writes: a slice copy of variable length is a `memcpy`
-/// call), then its rolling impulse.
+/// Writes a contact's stored states: `set(i, point, sums)` sets point `i` and its sums in
+/// place for each of its `count` points (fixed-size writes: a slice copy of variable length
+/// is a `memcpy` call), then its rolling impulse.
 #[inline(always)]
-fn write_stored(c: &mut Contact, count: u8, rolling_impulse: f32, set: impl Fn(usize, &mut PointState)) {
+fn write_stored(
+    c: &mut Contact,
+    sums: &mut ContactSums,
+    count: u8,
+    rolling_impulse: f32,
+    set: impl Fn(usize, &mut PointState, &mut PointSums),
+) {
     if count >= 1 {
-        set(0, &mut c.points[0]);
+        set(0, &mut c.points[0], &mut sums[0]);
     }
     if count >= 2 {
-        set(1, &mut c.points[1]);
+        set(1, &mut c.points[1], &mut sums[1]);
     }
     c.rolling_impulse = rolling_impulse;
 }
@@ -1175,10 +1185,10 @@ pub(crate) fn store_group<S: StateRead>(
     let restitution = FL::new(cold.restitution);
     let threshold = -FL::new(cold.restitution_threshold);
     // Each point's states, four lanes; `StoredGroup::new` transposes them into each
-    // lane's two rows, which are written straight into the contact's record, not into a
-    // `PointState` built on the stack first and copied (filling a default-made array field
-    // by field had stalled on store forwarding: the default's unaligned copies were still
-    // in flight when its 8-byte words were read back).
+    // lane's two rows, which are written straight into the contact's record and its sums
+    // (`PointSums`), not into a `PointState` built on the stack first and copied (filling
+    // a default-made array field by field had stalled on store forwarding: the default's
+    // unaligned copies were still in flight when its 8-byte words were read back).
     let point = |i: usize| {
         let (wp, normal) = (&w.points[i], h.points[i].normal_impulse);
         let (total_normal, max) = (wp.total_normal_impulse, wp.max_normal_impulse);
@@ -1244,8 +1254,9 @@ impl StoredPoint {
 }
 
 /// What the store writes into a group's four contacts ([`store_group`]), lane by lane:
-/// each point's eight floats transposed into two rows in [`PointState`]'s field order,
-/// which [`PointState::set_stored`] writes as two 16-byte stores (before: eight
+/// each point's eight floats transposed into two rows, in [`PointState`]'s and
+/// [`PointSums`]' field order, which [`StoredGroup::write_into`] writes as one 16-byte
+/// store each (before: eight
 /// single-lane extracts and eight scalar stores per point; large_pyramid's writes into the
 /// contacts ran 369 instructions a group, now 282, and the transposes, two shuffles a row,
 /// add 62 to `store_group`).
@@ -1277,39 +1288,43 @@ impl StoredGroup {
         }
     }
 
-    /// Sets `ps` to point `i`'s state in lane `l`.
+    /// Sets `ps` to point `i`'s state in lane `l`, and `sum` to its sums.
     #[inline(always)]
-    fn set_point(&self, i: usize, l: usize, ps: &mut PointState) {
+    fn set_point(&self, i: usize, l: usize, ps: &mut PointState, sum: &mut PointSums) {
         let [a, b] = &self.rows[l][i];
         let state = if self.stick[i][l] {
             FrictionState::Stick
         } else {
             FrictionState::Slip
         };
-        ps.set_stored([a[0], a[1], a[2], a[3]], [b[0], b[1], b[2], b[3]], state);
+        ps.set_stored([a[0], a[1], a[2], a[3]], state);
+        *sum = PointSums::from_row([b[0], b[1], b[2], b[3]]);
     }
 
-    /// Point `i`'s state in lane `l`.
+    /// Point `i`'s state in lane `l`, and its sums.
     #[inline(always)]
-    fn point(&self, i: usize, l: usize) -> PointState {
-        let mut ps = PointState::default();
-        self.set_point(i, l, &mut ps);
-        ps
+    fn point(&self, i: usize, l: usize) -> (PointState, PointSums) {
+        let (mut ps, mut sum) = (PointState::default(), PointSums::default());
+        self.set_point(i, l, &mut ps, &mut sum);
+        (ps, sum)
     }
 
-    /// Writes lane `l` into its contact (the manifold's points and the rolling impulse).
+    /// Writes lane `l` into its contact and its sums (the manifold's points and the rolling
+    /// impulse).
     #[inline(always)]
-    pub(crate) fn write_into(&self, l: usize, c: &mut Contact) {
-        write_stored(c, self.count[l], self.rolling_impulse[l], |i, ps| {
-            self.set_point(i, l, ps)
+    pub(crate) fn write_into(&self, l: usize, c: &mut Contact, sums: &mut ContactSums) {
+        write_stored(c, sums, self.count[l], self.rolling_impulse[l], |i, ps, sum| {
+            self.set_point(i, l, ps, sum)
         });
     }
 
     /// Lane `l` as a record of its own (for a contact written later, on one thread).
     #[super::lane_fn]
     pub(crate) fn lane(&self, l: usize) -> StoredContact {
+        let ((p0, s0), (p1, s1)) = (self.point(0, l), self.point(1, l));
         StoredContact {
-            points: [self.point(0, l), self.point(1, l)],
+            points: [p0, p1],
+            sums: [s0, s1],
             rolling_impulse: self.rolling_impulse[l],
             count: self.count[l].min(2),
         }
@@ -2163,29 +2178,47 @@ mod tests {
         for l in 0..3 {
             let cc = lane_call!(unpack_full(&h, &w, &cold, &f.soft, l));
             let mut c = crate::collision::contact::blank_contact();
-            store_impulses(&cc, &mut c, &moved, &f.ctx);
+            let mut sums = ContactSums::default();
+            store_impulses(&cc, &mut c, &mut sums, &moved, &f.ctx);
             let n = cc.count;
             assert_eq!(out[l].count as usize, n);
             // Compared through `Debug`, which tells −0.0 from +0.0 (float `==` does not).
             let bits = |points: &[PointState]| format!("{points:?}");
+            let sum_bits = |sums: &[PointSums]| format!("{sums:?}");
             assert_eq!(bits(&out[l].points[..n]), bits(&c.points[..n]), "lane {l}");
+            assert_eq!(sum_bits(&out[l].sums[..n]), sum_bits(&sums[..n]), "lane {l} sums");
             assert_eq!(out[l].rolling_impulse.to_bits(), c.rolling_impulse.to_bits());
-            // What the store stage calls: the lane written straight into a contact, its
-            // points past the manifold's count left as they were.
+            // What the store stage calls: the lane written straight into a contact and its
+            // sums, its points past the manifold's count left as they were.
             let mut written = crate::collision::contact::blank_contact();
-            let blank = written.points;
-            stored.write_into(l, &mut written);
+            let mut written_sums = [PointSums {
+                slip_speed: 7.0,
+                ..PointSums::default()
+            }; 2];
+            let (blank, blank_sums) = (written.points, written_sums);
+            stored.write_into(l, &mut written, &mut written_sums);
             assert_eq!(bits(&written.points[..n]), bits(&c.points[..n]), "lane {l} written");
+            assert_eq!(
+                sum_bits(&written_sums[..n]),
+                sum_bits(&sums[..n]),
+                "lane {l} sums written"
+            );
             assert_eq!(
                 bits(&written.points[n..]),
                 bits(&blank[n..]),
                 "lane {l}: no point past the count"
             );
+            assert_eq!(
+                sum_bits(&written_sums[n..]),
+                sum_bits(&blank_sums[n..]),
+                "lane {l}: no sums past the count"
+            );
             assert_eq!(written.rolling_impulse.to_bits(), c.rolling_impulse.to_bits());
             slipped |= c.points[..n].iter().any(|p| p.state == FrictionState::Slip);
             pushed |= c.points[..n]
                 .iter()
-                .any(|p| p.total_normal_impulse > 0.0 && p.drift != 0.0);
+                .zip(&sums)
+                .any(|(p, s)| s.total_normal_impulse > 0.0 && p.drift != 0.0);
         }
         assert!(slipped, "the fixture exercises a sliding point");
         assert!(pushed, "and a loaded sticking point with drift");

@@ -30,7 +30,7 @@ pub(crate) mod lanes8;
 pub(crate) mod softness;
 pub(crate) use crate::math::wide;
 
-use crate::collision::contact::Contact;
+use crate::collision::contact::{Contact, ContactSums};
 use crate::math::{Rot, Vec2};
 use crate::world::{Profile, Stopwatch};
 pub(crate) use softness::Softness;
@@ -844,9 +844,15 @@ pub(crate) trait WideContacts: ConstraintSet {
         loaded: bool,
         up: Vec2,
     );
-    /// Stores the step's impulses and friction states into `contacts` (see
-    /// `ContactSolver::store`).
-    fn store_step<S: StateRead + Sync>(&mut self, ctx: &StepContext, states: &[S], contacts: &mut [Option<Contact>]);
+    /// Stores the step's impulses and friction states into `contacts`, and the reported
+    /// sums into `sums` (one per contact slot; see `ContactSolver::store`).
+    fn store_step<S: StateRead + Sync>(
+        &mut self,
+        ctx: &StepContext,
+        states: &[S],
+        contacts: &mut [Option<Contact>],
+        sums: &mut [ContactSums],
+    );
 }
 
 /// The contact constraints of the world, in the build of the wide solver it runs: eight

@@ -1,7 +1,7 @@
 //! Contact events (pulled after each step) and read-only views of contacts.
 
 use super::{BodyId, ShapeId, World};
-use crate::collision::contact::FrictionState;
+use crate::collision::contact::{FrictionState, PointSums};
 use crate::error::Result;
 use crate::math::Vec2;
 
@@ -43,7 +43,10 @@ pub struct ContactPointInfo {
     pub point: Vec2,
     /// Separation [m] at the start of the step (negative = overlap).
     pub separation: f32,
-    /// Normal impulse applied over the whole step [N·s] (divide by dt for the force).
+    /// Normal impulse applied over the whole step [N·s] (divide by dt for the force); zero,
+    /// as are `friction_impulse` and `slip_speed`, when the step did not solve the contact
+    /// (neither body dynamic and awake). A sleeping body's contacts keep the values of their
+    /// last solved step.
     pub normal_impulse: f32,
     /// Friction impulse applied over the step along the tangent `(n.y, −n.x)` [N·s].
     pub friction_impulse: f32,
@@ -93,9 +96,8 @@ impl World {
     pub fn contacts(&self) -> impl Iterator<Item = ContactInfo> + '_ {
         self.contacts
             .iter()
-            .flatten()
-            .filter(|c| c.touching)
-            .map(move |c| self.contact_info(c))
+            .enumerate()
+            .filter_map(|(ci, c)| c.as_ref().filter(|c| c.touching).map(|c| self.contact_info(ci, c)))
     }
 
     /// Touching contacts of one body.
@@ -105,13 +107,15 @@ impl World {
         idx.sort_unstable();
         Ok(idx
             .into_iter()
-            .filter_map(|ci| self.contacts.get(ci as usize).and_then(|c| c.as_ref()))
-            .filter(|c| c.touching)
-            .map(|c| self.contact_info(c))
+            .filter_map(|ci| {
+                let c = self.contacts.get(ci as usize)?.as_ref()?;
+                c.touching.then(|| self.contact_info(ci as usize, c))
+            })
             .collect())
     }
 
-    fn contact_info(&self, c: &crate::collision::contact::Contact) -> ContactInfo {
+    /// The report of contact `ci`, whose record is `c`.
+    fn contact_info(&self, ci: usize, c: &crate::collision::contact::Contact) -> ContactInfo {
         let body_id = |i: u32| BodyId {
             index: i,
             generation: self.bodies.generation(i),
@@ -128,13 +132,14 @@ impl World {
         for (i, p) in points.iter_mut().enumerate().take(c.manifold.count) {
             let mp = &c.manifold.points[i];
             let ps = &c.points[i];
+            let sum = self.contact_sums.get(ci).map_or(PointSums::default(), |s| s[i]);
             *p = ContactPointInfo {
                 point: mp.point,
                 separation: mp.separation,
-                normal_impulse: ps.total_normal_impulse,
-                friction_impulse: ps.total_tangent_impulse,
+                normal_impulse: sum.total_normal_impulse,
+                friction_impulse: sum.total_tangent_impulse,
                 state: ps.state,
-                slip_speed: ps.slip_speed,
+                slip_speed: sum.slip_speed,
                 id: mp.id,
             };
         }

@@ -8,7 +8,9 @@
 
 use super::{ContactBeginEvent, ContactEndEvent, ShapeBounds, Stopwatch, World};
 use crate::collision::broad_phase::{MOVING_TREE, STATIC_TREE};
-use crate::collision::contact::{pair_key, Contact, Memo, NarrowOutcome, PointState, NO_COLOUR, RECYCLE_STEP};
+use crate::collision::contact::{
+    pair_key, Contact, ContactSums, Memo, NarrowOutcome, PointState, NO_COLOUR, RECYCLE_STEP,
+};
 use crate::dynamics::body::Body;
 use crate::dynamics::shape::ShapeRecord;
 use crate::dynamics::{mix, BodyType};
@@ -350,6 +352,7 @@ impl World {
             }
             None => {
                 self.contacts.push(Some(contact));
+                self.contact_sums.resize(self.contacts.len(), ContactSums::default());
                 (self.contacts.len() - 1) as u32
             }
         };
@@ -905,7 +908,14 @@ impl World {
             solve_step(ctx, &self.sims, cells, &mut set, &mut self.profile);
         }
         lap.lap();
-        solver.store_step(ctx, &self.states, &mut self.contacts);
+        self.contact_sums.resize(self.contacts.len(), ContactSums::default());
+        solver.store_step(ctx, &self.states, &mut self.contacts, &mut self.contact_sums);
+        // The touching contacts the solver did not take report nothing applied.
+        for &ci in &self.unsolved_contacts {
+            if let Some(sums) = self.contact_sums.get_mut(ci as usize) {
+                *sums = ContactSums::default();
+            }
+        }
         self.joint_solver = joints;
         self.store_joints(ctx);
         self.profile.store = lap.lap();
