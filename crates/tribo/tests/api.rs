@@ -792,7 +792,9 @@ fn a_resting_box_reports_the_impulses_that_hold_it_also_asleep() {
         assert_eq!(contacts.len(), 1, "one contact, with the floor");
         let points = contacts[0].points();
         assert_eq!(points.len(), 2, "a face contact");
-        assert!(points.iter().all(|p| p.state == tribo::FrictionState::Stick && p.slip_speed < 0.01));
+        assert!(points
+            .iter()
+            .all(|p| p.state == tribo::FrictionState::Stick && p.slip_speed < 0.01));
         let n: f32 = points.iter().map(|p| p.normal_impulse).sum();
         let t: f32 = points.iter().map(|p| p.friction_impulse).sum();
         (n, t)
@@ -803,7 +805,10 @@ fn a_resting_box_reports_the_impulses_that_hold_it_also_asleep() {
     let (n, t) = sums(&world);
     let (want_n, want_t) = (m * g * theta.cos() * DT, m * g * theta.sin() * DT);
     assert!((n - want_n).abs() < 0.01 * want_n, "normal {n} N·s, expected {want_n}");
-    assert!((t.abs() - want_t).abs() < 0.01 * want_t, "friction {t} N·s, expected ±{want_t}");
+    assert!(
+        (t.abs() - want_t).abs() < 0.01 * want_t,
+        "friction {t} N·s, expected ±{want_t}"
+    );
     let mut steps = 0;
     while world.body_is_awake(b).unwrap() {
         world.step(DT).unwrap();
@@ -812,6 +817,10 @@ fn a_resting_box_reports_the_impulses_that_hold_it_also_asleep() {
     }
     let asleep = sums(&world);
     world.step(DT).unwrap();
-    assert_eq!(sums(&world), asleep, "a sleeping contact keeps its last step's impulses");
+    assert_eq!(
+        sums(&world),
+        asleep,
+        "a sleeping contact keeps its last step's impulses"
+    );
     assert!((asleep.0 - want_n).abs() < 0.01 * want_n);
 }

@@ -116,6 +116,9 @@ pub(crate) struct ContactSolver {
     pub(crate) layout_kept: bool,
     /// Steps that kept the last step's layout (for tests and diagnostics).
     pub(crate) kept_layouts: u64,
+    /// Lanes the last store wrote after its runs, on one thread (their contacts lay outside
+    /// their run's range; for tests and diagnostics).
+    pub(crate) stored_after: usize,
     /// Counts the layouts made ([`ContactSolver::colour_and_lay_out`]): while it stands
     /// still, each step's solved order ([`ContactSolver::solved_order`]) is last step's.
     pub(crate) layouts: u64,
@@ -835,9 +838,10 @@ impl ContactSolver {
             let mut rest_sums: &mut [ContactSums] = &mut *sums;
             for (k, &(g, at)) in starts.iter().enumerate() {
                 let (end_group, end_at) = starts.get(k + 1).copied().unwrap_or((groups, usize::MAX));
-                let len = end_at.saturating_sub(at).min(rest.len());
+                // (`contacts` and `sums` have the same length.)
+                let len = end_at.saturating_sub(at).min(rest.len()).min(rest_sums.len());
                 let (mine, tail) = core::mem::take(&mut rest).split_at_mut(len);
-                let (mine_sums, tail_sums) = core::mem::take(&mut rest_sums).split_at_mut(len.min(rest_sums.len()));
+                let (mine_sums, tail_sums) = core::mem::take(&mut rest_sums).split_at_mut(len);
                 runs.push((g..end_group, at, (mine, mine_sums)));
                 rest = tail;
                 rest_sums = tail_sums;
@@ -853,6 +857,7 @@ impl ContactSolver {
             );
             strays.extend(kept.into_iter().flatten());
         }
+        self.stored_after = strays.len();
         for (contact, colour, stored) in strays {
             if let (Some(Some(c)), Some(sum)) = (contacts.get_mut(contact as usize), sums.get_mut(contact as usize)) {
                 stored.write_into(c, sum);

@@ -1440,8 +1440,14 @@ mod tests {
 
     /// A world without sleep, and its ground body (fixed at y = −1 m, no shape yet).
     fn sleepless_with_ground() -> (World, BodyId) {
+        sleepless_with_ground_on(1)
+    }
+
+    /// [`sleepless_with_ground`] stepped by `workers` threads.
+    fn sleepless_with_ground_on(workers: u32) -> (World, BodyId) {
         let mut w = World::new(WorldDef {
             enable_sleep: false,
+            workers,
             ..WorldDef::default()
         })
         .unwrap();
@@ -1460,7 +1466,12 @@ mod tests {
 
     /// A pyramid of `rows` rows of 1 m boxes on the ground, sleep off.
     fn pyramid(rows: usize) -> World {
-        let (mut w, ground) = sleepless_with_ground();
+        pyramid_on(rows, 1)
+    }
+
+    /// [`pyramid`] stepped by `workers` threads.
+    fn pyramid_on(rows: usize, workers: u32) -> World {
+        let (mut w, ground) = sleepless_with_ground_on(workers);
         let slab = Shape::Polygon(Polygon::new_box(200.0, 1.0).unwrap());
         w.create_shape(ground, &ShapeDef::default(), &slab).unwrap();
         let cube = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
@@ -1619,12 +1630,37 @@ mod tests {
             r
         };
         let before = (shape_pairs(&b), reports(&b));
-        let loaded = before.1.iter().flat_map(|c| c.points().to_vec()).filter(|p| p.normal_impulse > 0.0);
+        let loaded = before
+            .1
+            .iter()
+            .flat_map(|c| c.points().to_vec())
+            .filter(|p| p.normal_impulse > 0.0);
         assert!(loaded.count() > before.1.len(), "the pile's points carry load");
         b.reordered_at = None;
         b.reorder_contacts();
         assert_ne!(shape_pairs(&b), before.0, "b's contacts renumbered");
         assert_eq!(reports(&b), before.1);
+    }
+
+    /// The threaded store writes each run's contacts in place (`ContactSolver::store`):
+    /// once the contacts are renumbered in the solver's order, nearly every lane's contact
+    /// lies in its own run's range, and under 2 % of them are left to be written after, on
+    /// one thread. (A wrong cut of the contacts or of their sums between the runs leaves
+    /// them all to that serial pass: the results stay right, only slow.)
+    #[test]
+    fn the_threaded_store_writes_nearly_every_contact_in_place() {
+        let mut w = pyramid_on(70, 2); // over 7 000 contacts: two runs of the store
+        for _ in 0..40 {
+            w.step(1.0 / 60.0).unwrap();
+        }
+        assert!(w.reordered_at.is_some(), "the contacts were renumbered");
+        let after = with_contacts!(&w.contact_solver, s => s.stored_after);
+        let solved = w.solver_contacts.len();
+        assert!(solved > 7000);
+        assert!(
+            50 * after < solved,
+            "{after} of {solved} contacts stored after the runs"
+        );
     }
 
     /// Keeping last step's colours and layout when the candidates are unchanged
