@@ -824,3 +824,42 @@ fn a_resting_box_reports_the_impulses_that_hold_it_also_asleep() {
     );
     assert!((asleep.0 - want_n).abs() < 0.01 * want_n);
 }
+
+/// A touching contact the step does not solve reports nothing applied: a box resting on
+/// a moving kinematic platform reports its weight's impulse (m·g·dt, 1 %: at rest) while
+/// awake; put to sleep, its contact with the platform (kept up to date, the platform
+/// moves) is no longer solved and reports zero impulses and zero slip.
+#[test]
+fn a_contact_the_step_does_not_solve_reports_zero() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let platform = world.create_body(&BodyDef::kinematic(Vec2::new(0.0, -1.0))).unwrap();
+    world
+        .create_shape(
+            platform,
+            &ShapeDef::default(),
+            &Shape::Polygon(Polygon::new_box(50.0, 1.0).unwrap()),
+        )
+        .unwrap();
+    world.set_body_linear_velocity(platform, Vec2::new(0.5, 0.0)).unwrap();
+    let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 0.5))).unwrap();
+    world.create_shape(b, &ShapeDef::default(), &unit_box()).unwrap();
+    for _ in 0..60 {
+        world.step(DT).unwrap();
+    }
+    let points = |world: &World| {
+        let contacts = world.body_contacts(b).unwrap();
+        assert_eq!(contacts.len(), 1, "one contact, with the platform");
+        contacts[0].points().to_vec()
+    };
+    let weight = world.body_mass(b).unwrap() * 9.81 * DT;
+    let n: f32 = points(&world).iter().map(|p| p.normal_impulse).sum();
+    assert!((n - weight).abs() < 0.01 * weight, "normal {n} N·s, expected {weight}");
+    world.set_body_awake(b, false).unwrap();
+    world.step(DT).unwrap();
+    assert!(!world.body_is_awake(b).unwrap());
+    let asleep = points(&world);
+    assert_eq!(asleep.len(), 2);
+    assert!(asleep
+        .iter()
+        .all(|p| p.normal_impulse == 0.0 && p.friction_impulse == 0.0 && p.slip_speed == 0.0));
+}

@@ -119,6 +119,8 @@ pub(crate) struct ContactSolver {
     /// Lanes the last store wrote after its runs, on one thread (their contacts lay outside
     /// their run's range; for tests and diagnostics).
     pub(crate) stored_after: usize,
+    /// Runs the last store was cut into (for tests and diagnostics).
+    pub(crate) store_runs: usize,
     /// Counts the layouts made ([`ContactSolver::colour_and_lay_out`]): while it stands
     /// still, each step's solved order ([`ContactSolver::solved_order`]) is last step's.
     pub(crate) layouts: u64,
@@ -829,6 +831,8 @@ impl ContactSolver {
                 starts.push((g, first));
             }
         }
+        debug_assert_eq!(contacts.len(), sums.len(), "a sum per contact slot");
+        self.store_runs = starts.len();
         let mut strays = Vec::new();
         if starts.len() == 1 {
             self.store_groups(ctx, states, 0..groups, (contacts, sums), 0, &mut strays);
@@ -903,6 +907,11 @@ impl ContactSolver {
                     if cand != u32::MAX {
                         if let Some(c) = contacts.get(at(contact)) {
                             crate::solver::prefetch_lines(c, 1);
+                        }
+                        // (The sums follow the contacts' order, but only as closely as
+                        // the contacts follow the layout: spinner's are scattered.)
+                        if let Some(sum) = sums.get(at(contact)) {
+                            crate::solver::prefetch(sum);
                         }
                     }
                 }

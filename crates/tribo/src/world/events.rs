@@ -46,7 +46,8 @@ pub struct ContactPointInfo {
     /// Normal impulse applied over the whole step [N·s] (divide by dt for the force); zero,
     /// as are `friction_impulse` and `slip_speed`, when the step did not solve the contact
     /// (neither body dynamic and awake). A sleeping body's contacts keep the values of their
-    /// last solved step.
+    /// last solved step, unless an awake kinematic body moves them (touching, not solved:
+    /// zero).
     pub normal_impulse: f32,
     /// Friction impulse applied over the step along the tangent `(n.y, −n.x)` [N·s].
     pub friction_impulse: f32,

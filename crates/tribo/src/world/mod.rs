@@ -199,7 +199,10 @@ pub struct World {
     pub(crate) contacts: Vec<Option<Contact>>,
     /// What the last solved step did at each contact slot's points, for reports
     /// ([`PointSums`]: apart from the records, so the impulse store writes one line of
-    /// each); as long as `contacts` from the store on.
+    /// each); as long as `contacts`, in the same order (a slot's sums are zeroed when a new
+    /// contact takes it, and move with it when the contacts are renumbered).
+    ///
+    /// [`PointSums`]: crate::collision::contact::PointSums
     pub(crate) contact_sums: Vec<ContactSums>,
     pub(crate) contact_free: Vec<u32>,
     pub(crate) joints: Arena<crate::dynamics::joint::JointRecord>,
@@ -1629,6 +1632,8 @@ mod tests {
             r.sort_unstable_by_key(|c| (c.shape_a.index, c.shape_b.index));
             r
         };
+        // a renumbered in its steps: the same reports as b, pair by pair.
+        assert_eq!(reports(&a), reports(&b));
         let before = (shape_pairs(&b), reports(&b));
         let loaded = before
             .1
@@ -1655,6 +1660,11 @@ mod tests {
         }
         assert!(w.reordered_at.is_some(), "the contacts were renumbered");
         let after = with_contacts!(&w.contact_solver, s => s.stored_after);
+        assert_eq!(
+            with_contacts!(&w.contact_solver, s => s.store_runs),
+            2,
+            "one run per thread"
+        );
         let solved = w.solver_contacts.len();
         assert!(solved > 7000);
         assert!(

@@ -348,6 +348,9 @@ impl World {
         let ci = match self.contact_free.pop() {
             Some(i) => {
                 self.contacts[i as usize] = Some(contact);
+                if let Some(sums) = self.contact_sums.get_mut(i as usize) {
+                    *sums = ContactSums::default();
+                }
                 i
             }
             None => {
