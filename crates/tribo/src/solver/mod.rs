@@ -645,17 +645,44 @@ pub(crate) mod awake {
 /// `f` must not depend on the order in which items run (each writes only what no other
 /// writes), so the results are the same for any thread count.
 pub(crate) fn claim_each<T: Send>(parallel: bool, items: impl IntoIterator<Item = T>, f: impl Fn(T) + Sync) {
-    use core::sync::atomic::{AtomicUsize, Ordering::Relaxed};
     let threads = if parallel { rayon::current_num_threads() } else { 1 };
     if threads < 2 {
         items.into_iter().for_each(f);
         return;
     }
+    let items: Vec<T> = items.into_iter().collect();
+    let n = items.len();
+    let shares = threads.min(n);
+    let ends: Vec<usize> = (0..shares).map(|k| (k + 1) * n / shares).collect();
+    claim_shares(threads, items, &ends, f);
+}
+
+/// [`claim_each`] with each thread's share given: thread `k` claims the items of
+/// `shares[k]` first (one share per thread, so a stage can hand each thread what that
+/// thread touched in the stage before, when that is not a run of consecutive items).
+pub(crate) fn claim_each_share<T: Send>(parallel: bool, shares: Vec<Vec<T>>, f: impl Fn(T) + Sync) {
+    let threads = if parallel { rayon::current_num_threads() } else { 1 };
+    if threads < 2 {
+        shares.into_iter().flatten().for_each(f);
+        return;
+    }
+    let mut items = Vec::with_capacity(shares.iter().map(Vec::len).sum());
+    let mut ends = Vec::with_capacity(shares.len());
+    for share in shares.into_iter().take(threads) {
+        items.extend(share);
+        ends.push(items.len());
+    }
+    claim_shares(threads, items, &ends, f);
+}
+
+/// Runs `f` on `items` on `threads` threads, share `k` being `items[ends[k−1] .. ends[k]]`
+/// (from 0 for the first), as [`claim_each`] describes.
+fn claim_shares<T: Send>(threads: usize, items: Vec<T>, ends: &[usize], f: impl Fn(T) + Sync) {
+    use core::sync::atomic::{AtomicUsize, Ordering::Relaxed};
     // An item sits in its slot until one thread takes it (each slot is locked once).
     let slots: Vec<std::sync::Mutex<Option<T>>> = items.into_iter().map(|x| std::sync::Mutex::new(Some(x))).collect();
-    let n = slots.len();
-    let shares = threads.min(n);
-    if shares < 2 {
+    let shares = ends.len();
+    if shares < 2 || slots.len() < 2 {
         // One item (or none): this thread alone, without waking another.
         for slot in slots {
             if let Some(x) = slot.into_inner().unwrap_or_else(|e| e.into_inner()) {
@@ -664,12 +691,19 @@ pub(crate) fn claim_each<T: Send>(parallel: bool, items: impl IntoIterator<Item 
         }
         return;
     }
-    let end = |k: usize| (k + 1) * n / shares;
+    let start = |k: usize| {
+        if k == 0 {
+            0
+        } else {
+            ends.get(k - 1).copied().unwrap_or(0)
+        }
+    };
+    let end = |k: usize| ends.get(k).copied().unwrap_or(0);
     // The next unclaimed item of each share, each counter on its own cache lines (side by
     // side, every claim by one thread would take the line from the other).
     #[repr(align(128))]
     struct Cursor(AtomicUsize);
-    let next: Vec<Cursor> = (0..shares).map(|k| Cursor(AtomicUsize::new(k * n / shares))).collect();
+    let next: Vec<Cursor> = (0..shares).map(|k| Cursor(AtomicUsize::new(start(k)))).collect();
     let work = |k: usize| {
         for j in 0..shares {
             let share = (k + j) % shares;

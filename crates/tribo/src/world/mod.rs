@@ -1647,7 +1647,9 @@ mod tests {
         assert_eq!(reports(&b), before.1);
     }
 
-    /// The threaded store writes each run's contacts in place (`ContactSolver::store`):
+    /// With two threads, the build hands a kept layout's groups to the threads that solve
+    /// them (`ContactSolver::build_shares`), and the threaded store writes each run's
+    /// contacts in place (`ContactSolver::store`):
     /// once the contacts are renumbered in the solver's order, nearly every lane's contact
     /// lies in its own run's range, and under 2 % of them are left to be written after, on
     /// one thread. (A wrong cut of the contacts or of their sums between the runs leaves
@@ -1665,6 +1667,8 @@ mod tests {
             2,
             "one run per thread"
         );
+        // The kept layout's groups were built by the threads that solve them.
+        assert!(with_contacts!(&w.contact_solver, s => s.shared_builds) >= 30);
         let solved = w.solver_contacts.len();
         assert!(solved > 7000);
         assert!(
