@@ -239,9 +239,15 @@ fn team_body_blocks(n: usize, threads: usize, per_thread: usize) -> TeamPart<Tea
     part
 }
 
-/// The four group arrays cut into the chunks of `shares` (ranges of groups, each group in
-/// one range; [`ContactSolver::build_shares`]), thread by thread, each chunk with the
-/// index of its first group.
+/// Bodies per thread of the substep team (thread `k` integrates bodies `k·per_thread ..`),
+/// for `bodies` bodies: what its cuts (`ContactSolver::team_cuts`) are made for.
+fn team_bodies_per_thread(bodies: usize, threads: usize) -> usize {
+    bodies.div_ceil(threads).max(1)
+}
+
+/// The four group arrays cut into `chunks` (ranges of groups in ascending order, each
+/// with the thread that takes it; [`ContactSolver::build_shares`]), thread by thread, each
+/// chunk with the index of its first group. Groups outside every chunk are left out.
 #[allow(clippy::type_complexity)]
 fn split_shares<'a>(
     arrays: (
@@ -250,24 +256,18 @@ fn split_shares<'a>(
         &'a mut [WideCold],
         &'a mut [WideDerived],
     ),
-    shares: &[Vec<core::ops::Range<usize>>],
+    chunks: &[(core::ops::Range<usize>, usize)],
+    threads: usize,
 ) -> Vec<Vec<(usize, GroupChunk<'a>)>> {
-    // Every range in memory order, with its thread.
-    let mut ranges: Vec<(usize, usize, usize)> = shares
-        .iter()
-        .enumerate()
-        .flat_map(|(k, s)| s.iter().map(move |r| (r.start, r.end, k)))
-        .collect();
-    ranges.sort_unstable();
-    let mut out: Vec<Vec<(usize, GroupChunk<'a>)>> = shares.iter().map(|_| Vec::new()).collect();
+    let mut out: Vec<Vec<(usize, GroupChunk<'a>)>> = (0..threads).map(|_| Vec::new()).collect();
     let (mut h, mut w, mut c, mut d) = arrays;
     let mut taken = 0usize;
-    for (a, b, k) in ranges {
-        if a < taken || b > taken + h.len() {
-            continue; // overlapping or out of range: not a cut of these arrays
+    for (r, k) in chunks {
+        let (a, b) = (r.start, r.end);
+        if a < taken || b < a || b > taken + h.len() {
+            continue; // not ascending, or out of range: not a cut of these arrays
         }
-        let skip = a - taken;
-        let len = b - a;
+        let (skip, len) = (a - taken, b - a);
         let (_, h_rest) = core::mem::take(&mut h).split_at_mut(skip);
         let (_, w_rest) = core::mem::take(&mut w).split_at_mut(skip);
         let (_, c_rest) = core::mem::take(&mut c).split_at_mut(skip);
@@ -277,7 +277,7 @@ fn split_shares<'a>(
         let (cs, c_rest) = c_rest.split_at_mut(len);
         let (ds, d_rest) = d_rest.split_at_mut(len);
         (h, w, c, d, taken) = (h_rest, w_rest, c_rest, d_rest, b);
-        if let Some(share) = out.get_mut(k) {
+        if let Some(share) = out.get_mut(*k) {
             share.push((a, (hs, ws, cs, ds)));
         }
     }
@@ -442,9 +442,9 @@ impl ContactSolver {
             &mut self.derived[..],
         );
         match shares {
-            Some(shares) => {
+            Some((chunks, threads)) => {
                 self.shared_builds += 1;
-                let items = split_shares(arrays, &shares);
+                let items = split_shares(arrays, &chunks, threads);
                 claim_each_share(true, items, |(first, (h, w, c, d))| build_chunk(first, h, w, c, d));
             }
             None => for_each_chunk_mut4(ctx.parallel, arrays, GROUP_CHUNK, build_chunk),
@@ -1209,7 +1209,7 @@ impl ContactSolver {
             return false;
         }
         let soft = self.soft;
-        let bodies_per_thread = sims.len().div_ceil(threads).max(1);
+        let bodies_per_thread = team_bodies_per_thread(sims.len(), threads);
         let colours = self.team_blocks(threads, bodies_per_thread);
         let bodies = [team_body_blocks(sims.len(), threads, bodies_per_thread)];
         let progress = TeamProgress::new();
@@ -1274,32 +1274,30 @@ impl ContactSolver {
     }
 
     /// Which thread builds which groups: with threads, when the team's cuts of this layout
-    /// are known (a layout kept from the last step, whose solve cut it), each thread's
-    /// share is the groups it solves (`team_cuts`), in [`GROUP_CHUNK`]s (the groups between
-    /// cuts, if any, go to the first thread); else `None` (the groups cut into one run per
-    /// thread by count). Built by the thread that solves them, a group's lines stay in that
-    /// core's cache for the first warm start; built by the other (a run by count crosses
-    /// the colours' cuts), they were fetched across: on two threads large_pyramid's
-    /// `build_group` took 70 % more processor time than on one. Which thread builds a
-    /// group changes no result.
-    fn build_shares(&self, ctx: &StepContext, bodies: usize) -> Option<Vec<Vec<core::ops::Range<usize>>>> {
+    /// are known (a layout kept from the last step, whose solve cut it), each thread takes
+    /// the groups it solves (`team_cuts`), in [`GROUP_CHUNK`]s (the groups between cuts, if
+    /// any, go to the first thread): the chunks in ascending order, each with its thread,
+    /// and the thread count; else `None` (the groups cut into one run per thread by count).
+    /// Built by the thread that solves them, a group's lines stay in that core's cache for
+    /// the first warm start; built by the other (a run by count crosses the colours' cuts),
+    /// they were fetched across: on two threads large_pyramid's `build_group` took 70 % more
+    /// processor time than on one. Which thread builds a group changes no result.
+    fn build_shares(&self, ctx: &StepContext, bodies: usize) -> Option<(Vec<(core::ops::Range<usize>, usize)>, usize)> {
         if !ctx.parallel {
             return None;
         }
         let threads = rayon::current_num_threads();
-        let id = (self.layouts, threads, bodies.div_ceil(threads).max(1));
+        let id = (self.layouts, threads, team_bodies_per_thread(bodies, threads));
         let (at, cuts) = self.cuts_cache.as_ref()?;
         if threads < 2 || *at != id {
             return None;
         }
-        let mut shares: Vec<Vec<core::ops::Range<usize>>> = vec![Vec::new(); threads];
+        let mut chunks = Vec::new();
         let mut push = |k: usize, a: usize, b: usize| {
             let mut at = a;
             while at < b {
                 let next = (at + GROUP_CHUNK).min(b);
-                if let Some(share) = shares.get_mut(k) {
-                    share.push(at..next);
-                }
+                chunks.push((at..next, k));
                 at = next;
             }
         };
@@ -1315,7 +1313,7 @@ impl ContactSolver {
             done = done.max(at.last().copied().unwrap_or(done));
         }
         push(0, done, self.head.len());
-        Some(shares)
+        Some((chunks, threads))
     }
 
     /// The team's blocks: per colour, its front and back parts (see [`fast_first`]), each
@@ -1537,7 +1535,11 @@ mod tests {
             cold.contact[0] = g as u32;
         }
         let shares = vec![vec![0..5, 12..20, 30..40], vec![5..12, 20..28]];
-        let out = split_shares((&mut h, &mut w, &mut c, &mut d), &shares);
+        let mut chunks: Vec<_> = (0..2)
+            .flat_map(|k| shares[k].iter().map(move |r| (r.clone(), k)))
+            .collect();
+        chunks.sort_unstable_by_key(|(r, _)| r.start);
+        let out = split_shares((&mut h, &mut w, &mut c, &mut d), &chunks, 2);
         let mut owner = vec![None; n];
         for (k, chunks) in out.iter().enumerate() {
             for (first, (hs, ws, cs, ds)) in chunks {

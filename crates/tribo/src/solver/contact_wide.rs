@@ -1256,10 +1256,9 @@ impl StoredPoint {
 /// What the store writes into a group's four contacts ([`store_group`]), lane by lane:
 /// each point's eight floats transposed into two rows, in [`PointState`]'s and
 /// [`PointSums`]' field order, which [`StoredGroup::write_into`] writes as one 16-byte
-/// store each (before: eight
-/// single-lane extracts and eight scalar stores per point; large_pyramid's writes into the
-/// contacts ran 369 instructions a group, now 282, and the transposes, two shuffles a row,
-/// add 62 to `store_group`).
+/// store each (before: eight single-lane extracts and eight scalar stores per point;
+/// large_pyramid's writes into the contacts ran 369 instructions a group, now 282, and the
+/// transposes, two shuffles a row, add 62 to `store_group`).
 pub(crate) struct StoredGroup {
     /// `rows[l][i]`: point `i` of lane `l`, (normal, tangent, drift, preload) and (total
     /// normal, total tangent, max normal, slip speed).

@@ -650,11 +650,17 @@ pub(crate) fn claim_each<T: Send>(parallel: bool, items: impl IntoIterator<Item 
         items.into_iter().for_each(f);
         return;
     }
-    let items: Vec<T> = items.into_iter().collect();
-    let n = items.len();
+    let slots = claim_slots(items);
+    let n = slots.len();
     let shares = threads.min(n);
     let ends: Vec<usize> = (0..shares).map(|k| (k + 1) * n / shares).collect();
-    claim_shares(threads, items, &ends, f);
+    claim_shares(threads, slots, &ends, f);
+}
+
+/// The items of a [`claim_each`] in their slots: each sits in its slot until one thread
+/// takes it (each slot is locked once).
+fn claim_slots<T>(items: impl IntoIterator<Item = T>) -> Vec<std::sync::Mutex<Option<T>>> {
+    items.into_iter().map(|x| std::sync::Mutex::new(Some(x))).collect()
 }
 
 /// [`claim_each`] with each thread's share given: thread `k` claims the items of
@@ -666,21 +672,24 @@ pub(crate) fn claim_each_share<T: Send>(parallel: bool, shares: Vec<Vec<T>>, f: 
         shares.into_iter().flatten().for_each(f);
         return;
     }
-    let mut items = Vec::with_capacity(shares.iter().map(Vec::len).sum());
+    let mut slots = Vec::with_capacity(shares.iter().map(Vec::len).sum());
     let mut ends = Vec::with_capacity(shares.len());
     for share in shares.into_iter().take(threads) {
-        items.extend(share);
-        ends.push(items.len());
+        slots.extend(claim_slots(share));
+        ends.push(slots.len());
     }
-    claim_shares(threads, items, &ends, f);
+    claim_shares(threads, slots, &ends, f);
 }
 
-/// Runs `f` on `items` on `threads` threads, share `k` being `items[ends[k−1] .. ends[k]]`
-/// (from 0 for the first), as [`claim_each`] describes.
-fn claim_shares<T: Send>(threads: usize, items: Vec<T>, ends: &[usize], f: impl Fn(T) + Sync) {
+/// Runs `f` on the items in `slots` on `threads` threads, share `k` being
+/// `slots[ends[k−1] .. ends[k]]` (from 0 for the first), as [`claim_each`] describes.
+fn claim_shares<T: Send>(
+    threads: usize,
+    slots: Vec<std::sync::Mutex<Option<T>>>,
+    ends: &[usize],
+    f: impl Fn(T) + Sync,
+) {
     use core::sync::atomic::{AtomicUsize, Ordering::Relaxed};
-    // An item sits in its slot until one thread takes it (each slot is locked once).
-    let slots: Vec<std::sync::Mutex<Option<T>>> = items.into_iter().map(|x| std::sync::Mutex::new(Some(x))).collect();
     let shares = ends.len();
     if shares < 2 || slots.len() < 2 {
         // One item (or none): this thread alone, without waking another.

@@ -911,7 +911,6 @@ impl World {
             solve_step(ctx, &self.sims, cells, &mut set, &mut self.profile);
         }
         lap.lap();
-        self.contact_sums.resize(self.contacts.len(), ContactSums::default());
         solver.store_step(ctx, &self.states, &mut self.contacts, &mut self.contact_sums);
         // The touching contacts the solver did not take report nothing applied.
         for &ci in &self.unsolved_contacts {
