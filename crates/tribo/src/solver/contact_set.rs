@@ -256,7 +256,7 @@ fn split_shares<'a>(
         &'a mut [WideCold],
         &'a mut [WideDerived],
     ),
-    chunks: &[(core::ops::Range<usize>, usize)],
+    chunks: &BuildChunks,
     threads: usize,
 ) -> Vec<Vec<(usize, GroupChunk<'a>)>> {
     let mut out: Vec<Vec<(usize, GroupChunk<'a>)>> = (0..threads).map(|_| Vec::new()).collect();
@@ -283,6 +283,10 @@ fn split_shares<'a>(
     }
     out
 }
+
+/// The build's chunks of groups, ascending, each with the thread that takes it
+/// ([`ContactSolver::build_shares`]).
+type BuildChunks = Vec<(core::ops::Range<usize>, usize)>;
 
 /// A run of groups' four arrays.
 type GroupChunk<'a> = (
@@ -1282,7 +1286,7 @@ impl ContactSolver {
     /// the first warm start; built by the other (a run by count crosses the colours' cuts),
     /// they were fetched across: on two threads large_pyramid's `build_group` took 70 % more
     /// processor time than on one. Which thread builds a group changes no result.
-    fn build_shares(&self, ctx: &StepContext, bodies: usize) -> Option<(Vec<(core::ops::Range<usize>, usize)>, usize)> {
+    fn build_shares(&self, ctx: &StepContext, bodies: usize) -> Option<(BuildChunks, usize)> {
         if !ctx.parallel {
             return None;
         }
