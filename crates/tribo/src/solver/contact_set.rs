@@ -121,6 +121,11 @@ pub(crate) struct ContactSolver {
     pub(crate) stored_after: usize,
     /// Runs the last store was cut into (for tests and diagnostics).
     pub(crate) store_runs: usize,
+    /// Where each thread's share of the contact list starts (ascending starts, the first
+    /// at 0, each with its thread; empty on one thread or without a team): the contacts of
+    /// the groups each thread solved in the last step, for the next narrow phase to hand
+    /// each thread the contacts whose lines its core holds.
+    pub(crate) contact_owners: Vec<(usize, usize)>,
     /// Builds whose groups were handed to the threads that solve them
     /// ([`ContactSolver::build_shares`]; for tests and diagnostics).
     pub(crate) shared_builds: u64,
@@ -899,14 +904,19 @@ impl ContactSolver {
         let mut starts = vec![(0usize, 0usize)];
         for k in 1..tasks {
             let g = k * groups / tasks;
-            let first = match (self.lane_candidates.get(g), self.cold.get(g)) {
-                (Some(lanes), Some(cold)) if lanes[0] != u32::MAX => cold.contact[0] as usize,
-                _ => continue,
-            };
+            let Some(first) = self.first_contact(g) else { continue };
             if starts.last().is_some_and(|&(_, at)| first > at) && first < contacts.len() {
                 starts.push((g, first));
             }
         }
+        // Who visits which contacts in the next narrow phase.
+        let mut owners = core::mem::take(&mut self.contact_owners);
+        if ctx.parallel {
+            self.find_contact_owners(contacts.len(), &mut owners);
+        } else {
+            owners.clear();
+        }
+        self.contact_owners = owners;
         debug_assert_eq!(contacts.len(), sums.len(), "a sum per contact slot");
         self.store_runs = starts.len();
         let mut strays = Vec::new();
@@ -1279,30 +1289,51 @@ impl ContactSolver {
 
     /// Which thread builds which groups: with threads, when the team's cuts of this layout
     /// are known (a layout kept from the last step, whose solve cut it), each thread takes
-    /// the groups it solves (`team_cuts`), in [`GROUP_CHUNK`]s (the groups between cuts, if
-    /// any, go to the first thread): the chunks in ascending order, each with its thread,
-    /// and the thread count; else `None` (the groups cut into one run per thread by count).
-    /// Built by the thread that solves them, a group's lines stay in that core's cache for
-    /// the first warm start; built by the other (a run by count crosses the colours' cuts),
-    /// they were fetched across: on two threads large_pyramid's `build_group` took 70 % more
-    /// processor time than on one. Which thread builds a group changes no result.
+    /// the groups it solves ([`ContactSolver::team_shares`]), in [`GROUP_CHUNK`]s: the
+    /// chunks in ascending order, each with its thread, and the thread count; else `None`
+    /// (the groups cut into one run per thread by count). Built by the thread that solves
+    /// them, a group's lines stay in that core's cache for the first warm start; built by
+    /// the other (a run by count crosses the colours' cuts), they were fetched across: on
+    /// two threads large_pyramid's `build_group` took 70 % more processor time than on one.
+    /// Which thread builds a group changes no result.
     fn build_shares(&self, ctx: &StepContext, bodies: usize) -> Option<(BuildChunks, usize)> {
         if !ctx.parallel {
             return None;
         }
         let threads = rayon::current_num_threads();
-        let id = (self.layouts, threads, team_bodies_per_thread(bodies, threads));
-        let (at, cuts) = self.cuts_cache.as_ref()?;
-        if threads < 2 || *at != id {
+        let (at, _) = self.cuts_cache.as_ref()?;
+        if at.2 != team_bodies_per_thread(bodies, threads) {
             return None;
         }
         let mut chunks = Vec::new();
-        let mut push = |k: usize, a: usize, b: usize| {
-            let mut at = a;
-            while at < b {
-                let next = (at + GROUP_CHUNK).min(b);
+        for (r, k) in self.team_shares(threads)? {
+            let mut at = r.start;
+            while at < r.end {
+                let next = (at + GROUP_CHUNK).min(r.end);
                 chunks.push((at..next, k));
                 at = next;
+            }
+        }
+        Some((chunks, threads))
+    }
+
+    /// The groups each thread of a team of `threads` solves, when the team's cuts of this
+    /// layout are known: ascending ranges that cover every group, each with its thread (the
+    /// groups between cuts, if any, go to the first thread), a thread's neighbouring
+    /// ranges merged; else `None`.
+    fn team_shares(&self, threads: usize) -> Option<BuildChunks> {
+        let (at, cuts) = self.cuts_cache.as_ref()?;
+        if threads < 2 || at.0 != self.layouts || at.1 != threads {
+            return None;
+        }
+        let mut shares: BuildChunks = Vec::new();
+        let mut push = |k: usize, a: usize, b: usize| {
+            if a >= b {
+                return;
+            }
+            match shares.last_mut() {
+                Some((r, j)) if *j == k && r.end == a => r.end = b,
+                _ => shares.push((a..b, k)),
             }
         };
         let mut done = 0usize;
@@ -1317,7 +1348,44 @@ impl ContactSolver {
             done = done.max(at.last().copied().unwrap_or(done));
         }
         push(0, done, self.head.len());
-        Some((chunks, threads))
+        Some(shares)
+    }
+
+    /// The contact of group `g`'s first lane (`None` for an empty lane or no group).
+    fn first_contact(&self, g: usize) -> Option<usize> {
+        match (self.lane_candidates.get(g), self.cold.get(g)) {
+            (Some(lanes), Some(cold)) if lanes[0] != u32::MAX => Some(cold.contact[0] as usize),
+            _ => None,
+        }
+    }
+
+    /// [`ContactSolver::contact_owners`]: where each thread's share of the team
+    /// ([`ContactSolver::team_shares`]) starts in the contact list (of `contacts` slots),
+    /// into `out`; empty without a team's cuts. A share whose first contact does not lie
+    /// after the last start (contacts made since the last renumbering) joins the share
+    /// before.
+    fn find_contact_owners(&self, contacts: usize, out: &mut Vec<(usize, usize)>) {
+        out.clear();
+        let Some(shares) = self.team_shares(rayon::current_num_threads()) else {
+            return;
+        };
+        for (r, k) in shares {
+            let Some(first) = self.first_contact(r.start) else {
+                continue;
+            };
+            match out.last_mut() {
+                None => out.push((0, k)),
+                Some(last) if last.1 == k => {}
+                Some(last) => {
+                    if first > last.0 && first < contacts {
+                        out.push((first, k));
+                    }
+                }
+            }
+        }
+        if out.len() < 2 {
+            out.clear();
+        }
     }
 
     /// The team's blocks: per colour, its front and back parts (see [`fast_first`]), each

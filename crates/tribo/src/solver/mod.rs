@@ -799,6 +799,40 @@ pub(crate) fn for_each_chunk_mut4<A: Send, B: Send, C: Send, D: Send>(
     }
 }
 
+/// [`for_each_chunk_mut4`] on threads, with each thread's share given: `owners` lists
+/// where each thread's part of the slices starts (ascending starts, each with its thread;
+/// the first from 0), and each part is cut into chunks of at most `min_len` that its
+/// thread claims first ([`claim_each_share`]). The slices have one length.
+pub(crate) fn for_each_chunk_mut4_owned<A: Send, B: Send, C: Send, D: Send>(
+    slices: (&mut [A], &mut [B], &mut [C], &mut [D]),
+    owners: &[(usize, usize)],
+    min_len: usize,
+    f: impl Fn(usize, &mut [A], &mut [B], &mut [C], &mut [D]) + Sync,
+) {
+    let threads = rayon::current_num_threads();
+    let n = min_len.max(1);
+    let (mut a, mut b, mut c, mut d) = slices;
+    let len = a.len().min(b.len()).min(c.len()).min(d.len());
+    let mut shares: Vec<Vec<_>> = (0..threads).map(|_| Vec::new()).collect();
+    let mut at = 0usize;
+    for (i, &(_, k)) in owners.iter().enumerate() {
+        let end = owners.get(i + 1).map_or(len, |o| o.0.min(len));
+        while at < end {
+            let m = (end - at).min(n);
+            let (w, w_rest) = core::mem::take(&mut a).split_at_mut(m);
+            let (x, x_rest) = core::mem::take(&mut b).split_at_mut(m);
+            let (y, y_rest) = core::mem::take(&mut c).split_at_mut(m);
+            let (z, z_rest) = core::mem::take(&mut d).split_at_mut(m);
+            (a, b, c, d) = (w_rest, x_rest, y_rest, z_rest);
+            if let Some(share) = shares.get_mut(k.min(threads - 1)) {
+                share.push((at, (w, x, y, z)));
+            }
+            at += m;
+        }
+    }
+    claim_each_share(true, shares, |(first, (w, x, y, z))| f(first, w, x, y, z));
+}
+
 /// A family of constraints solved by the step (contacts now; joints later). The set is
 /// built before the step's stages run.
 pub(crate) trait ConstraintSet {
@@ -1153,7 +1187,7 @@ pub(crate) fn integrate_position_one<S: StateCell>(ctx: &StepContext, sim: &Body
 
 #[cfg(test)]
 mod claim_tests {
-    use super::{claim_each, for_each_chunk_mut4};
+    use super::{claim_each, for_each_chunk_mut4, for_each_chunk_mut4_owned};
     use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
     /// Every item runs exactly once, on two threads as on one, for counts below, at and
@@ -1193,6 +1227,43 @@ mod claim_tests {
         });
         assert!(a.iter().enumerate().all(|(i, &x)| x == i));
         assert!(b.iter().chain(&c).chain(&d).all(|&y| y == 1));
+    }
+
+    /// The form with owners given cuts every share into chunks of at most the chunk length
+    /// that never cross a share's start, and still writes every element once with its own
+    /// index (shares whose starts are off the chunk grid included).
+    #[test]
+    fn owned_chunks_stay_inside_their_shares() {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("pool");
+        let n = 1001;
+        let owners = [(0usize, 1usize), (96, 0), (300, 1), (301, 0), (900, 1)];
+        let (mut a, mut b, mut c, mut d) = (vec![0usize; n], vec![0u8; n], vec![0u8; n], vec![0u8; n]);
+        let chunks = std::sync::Mutex::new(Vec::new());
+        pool.install(|| {
+            for_each_chunk_mut4_owned(
+                (&mut a, &mut b, &mut c, &mut d),
+                &owners,
+                32,
+                |first, ws, xs, ys, zs| {
+                    chunks.lock().expect("chunk list").push((first, ws.len()));
+                    let rows = ws.iter_mut().zip(xs.iter_mut()).zip(ys.iter_mut()).zip(zs.iter_mut());
+                    for (k, (((w, x), y), z)) in rows.enumerate() {
+                        *w = first + k;
+                        *x += 1;
+                        *y += 1;
+                        *z += 1;
+                    }
+                },
+            )
+        });
+        assert!(a.iter().enumerate().all(|(i, &x)| x == i));
+        assert!(b.iter().chain(&c).chain(&d).all(|&y| y == 1));
+        let chunks = chunks.into_inner().expect("chunk list");
+        for (first, len) in chunks {
+            assert!((1..=32).contains(&len), "chunk at {first} of {len}");
+            let crosses = owners.iter().any(|&(at, _)| first < at && at < first + len);
+            assert!(!crosses, "chunk {first}..{} crosses a share's start", first + len);
+        }
     }
 
     /// Inside a step, every stage leaves a spinner on the pool's other thread

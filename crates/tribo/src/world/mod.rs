@@ -1228,6 +1228,8 @@ impl World {
         permute_live(&mut self.contact_sums, &new_of_old, live);
         self.contact_free.clear();
         self.reordered_at = Some(self.step_count);
+        // The threads' shares of the contact list were found in the old numbering.
+        crate::solver::with_contacts!(&mut self.contact_solver, s => s.contact_owners.clear());
         let renumber = |ci: &mut u32| *ci = new_of_old.get(*ci as usize).copied().unwrap_or(u32::MAX);
         // Every value is replaced independently of the others: the map's order cannot
         // reach the result.
@@ -1669,6 +1671,15 @@ mod tests {
         );
         // The kept layout's groups were built by the threads that solve them.
         assert!(with_contacts!(&w.contact_solver, s => s.shared_builds) >= 30);
+        // And the next narrow phase hands each thread the contacts of its groups: a share
+        // of each thread's at least, ascending from contact 0.
+        let owners = with_contacts!(&w.contact_solver, s => s.contact_owners.clone());
+        assert_eq!(owners.first().map(|o| o.0), Some(0), "{owners:?}");
+        assert!(
+            owners.windows(2).all(|o| o[0].0 < o[1].0 && o[0].1 != o[1].1),
+            "{owners:?}"
+        );
+        assert!(owners.iter().any(|o| o.1 == 1), "{owners:?}");
         let solved = w.solver_contacts.len();
         assert!(solved > 7000);
         assert!(

@@ -450,103 +450,123 @@ impl World {
         let footprint = core::mem::size_of_val(solver_bodies) + core::mem::size_of_val(bounds);
         let near_ahead = footprint > NEAR_PREFETCH_BYTES;
         let collided_total = core::sync::atomic::AtomicU32::new(0);
-        for_each_chunk_mut4(
-            parallel,
-            (&mut self.contacts, &mut candidates, &mut keys, &mut outcomes),
-            CONTACT_CHUNK,
-            |first, slots, cands, keys, outs| {
-                let mut collided = 0u32;
-                let len = slots.len();
-                // The active contacts of this chunk (all its slots when mostly awake).
-                // A listed contact's slot in this chunk (the list's share below holds only
-                // contacts from `first` on).
-                let local = |ci: u32| (ci as usize).wrapping_sub(first);
-                let mine = if mostly_awake {
-                    &[][..]
-                } else {
-                    let lo = active_ref.partition_point(|&ci| (ci as usize) < first);
-                    let hi = active_ref.partition_point(|&ci| (ci as usize) < first + len);
-                    active_ref.get(lo..hi).unwrap_or(&[])
-                };
-                // Visits slot `k`; `record` and `near`: the slots of the contacts whose
-                // record, and whose bodies and bounds, are asked for ahead.
-                // (A macro, not a closure: called from two loops, a closure was not inlined,
-                // and the mostly-awake loop ran 29 % more instructions.)
-                macro_rules! visit {
-                    ($k:expr, $record:expr, $near:expr) => {{
-                        let (k, record, near): (usize, Option<usize>, Option<usize>) = ($k, $record, $near);
-                        // The record of a contact further ahead, all five lines: the hardware
-                        // prefetcher does not keep far enough ahead of this stream
-                        // (many_pyramids, 58 000 recycled contacts, 18.5 MB a step: the wait
-                        // for the record read four ahead below was three quarters of this
-                        // loop's samples, and collide fell from 1.27-1.53 to 0.79-0.89
-                        // relax units with it).
-                        if let Some(far) = record.and_then(|r| slots.get(r)) {
-                            crate::solver::prefetch(far);
-                        }
-                        // The bodies and shape bounds of a contact a few ahead: loads that
-                        // miss (contacts come in solver order, not body order) and that the
-                        // narrow phase needs before anything else.
-                        if let Some(Some(ahead)) = near.filter(|_| near_ahead).and_then(|r| slots.get(r)) {
-                            for bi in [ahead.body_a, ahead.body_b] {
-                                if let Some(sb) = solver_bodies.get(bi as usize) {
-                                    crate::solver::prefetch(sb);
-                                }
-                            }
-                            for id in [ahead.shape_a, ahead.shape_b] {
-                                if let Some(sb) = bounds.get(id.index as usize) {
-                                    crate::solver::prefetch(sb);
-                                }
-                                if geometry_ahead {
-                                    shapes.prefetch_n(id.index, 3);
-                                }
-                            }
-                        }
-                        let (Some(slot), Some(cand), Some(key), Some(out)) = (
-                            slots.get_mut(k),
-                            cands.get_mut(k),
-                            keys.get_mut(k),
-                            outs.get_mut(k),
-                        ) else {
-                            continue;
-                        };
-                        match slot.as_mut() {
-                            Some(c) if !mostly_awake || flag(c.body_a) || flag(c.body_b) => {
-                                update(first + k, c, cand, key, out, &mut collided)
-                            }
-                            _ => *out = (NarrowOutcome::Skipped, false),
-                        }
-                    }};
-                }
-                if mostly_awake {
-                    for k in 0..len {
-                        visit!(k, Some(k + RECORD_PREFETCH), Some(k + NARROW_PREFETCH));
-                    }
-                } else {
-                    let slot_of = |j: usize| mine.get(j).map(|&ci| local(ci));
-                    for (j, &ci) in mine.iter().enumerate() {
-                        visit!(local(ci), slot_of(j + RECORD_PREFETCH), slot_of(j + NARROW_PREFETCH));
-                    }
-                }
-                // The chunk's verdicts filed in its lists, from the dense outcomes just
-                // written (kept out of the loop above, whose pushes slowed it).
-                if let Some(list) = lists_ref.get(first / CONTACT_CHUNK) {
-                    let mut list = list.lock().unwrap_or_else(|e| e.into_inner());
-                    if mostly_awake {
-                        for (k, &(outcome, solvable)) in outs.iter().enumerate() {
-                            list.note((first + k) as u32, outcome, solvable);
-                        }
-                    } else {
-                        for &ci in mine {
-                            if let Some(&(outcome, solvable)) = outs.get(local(ci)) {
-                                list.note(ci, outcome, solvable);
-                            }
-                        }
-                    }
-                }
-                collided_total.fetch_add(collided, core::sync::atomic::Ordering::Relaxed);
-            },
+        // On threads, each visits the contacts of the groups it solved last step (the
+        // contacts follow the solver's layout): the candidates and keys it writes here are
+        // read by the build on that thread (`ContactSolver::build_shares`), so their lines
+        // no longer cross between the cores. Cut by count instead, half of them did:
+        // large_pyramid's two-thread collide took 0.30 ms against 0.26.
+        let owners = if parallel {
+            crate::solver::with_contacts!(&self.contact_solver, s => grid_owners(&s.contact_owners, CONTACT_CHUNK))
+        } else {
+            Vec::new()
+        };
+        let slices = (
+            self.contacts.as_mut_slice(),
+            candidates.as_mut_slice(),
+            keys.as_mut_slice(),
+            outcomes.as_mut_slice(),
         );
+        let run = |first: usize,
+                   slots: &mut [Option<Contact>],
+                   cands: &mut [Candidate],
+                   keys: &mut [ColourKey],
+                   outs: &mut [(NarrowOutcome, bool)]| {
+            let mut collided = 0u32;
+            let len = slots.len();
+            // The active contacts of this chunk (all its slots when mostly awake).
+            // A listed contact's slot in this chunk (the list's share below holds only
+            // contacts from `first` on).
+            let local = |ci: u32| (ci as usize).wrapping_sub(first);
+            let mine = if mostly_awake {
+                &[][..]
+            } else {
+                let lo = active_ref.partition_point(|&ci| (ci as usize) < first);
+                let hi = active_ref.partition_point(|&ci| (ci as usize) < first + len);
+                active_ref.get(lo..hi).unwrap_or(&[])
+            };
+            // Visits slot `k`; `record` and `near`: the slots of the contacts whose
+            // record, and whose bodies and bounds, are asked for ahead.
+            // (A macro, not a closure: called from two loops, a closure was not inlined,
+            // and the mostly-awake loop ran 29 % more instructions.)
+            macro_rules! visit {
+                ($k:expr, $record:expr, $near:expr) => {{
+                    let (k, record, near): (usize, Option<usize>, Option<usize>) = ($k, $record, $near);
+                    // The record of a contact further ahead, all five lines: the hardware
+                    // prefetcher does not keep far enough ahead of this stream
+                    // (many_pyramids, 58 000 recycled contacts, 18.5 MB a step: the wait
+                    // for the record read four ahead below was three quarters of this
+                    // loop's samples, and collide fell from 1.27-1.53 to 0.79-0.89
+                    // relax units with it).
+                    if let Some(far) = record.and_then(|r| slots.get(r)) {
+                        crate::solver::prefetch(far);
+                    }
+                    // The bodies and shape bounds of a contact a few ahead: loads that
+                    // miss (contacts come in solver order, not body order) and that the
+                    // narrow phase needs before anything else.
+                    if let Some(Some(ahead)) = near.filter(|_| near_ahead).and_then(|r| slots.get(r)) {
+                        for bi in [ahead.body_a, ahead.body_b] {
+                            if let Some(sb) = solver_bodies.get(bi as usize) {
+                                crate::solver::prefetch(sb);
+                            }
+                        }
+                        for id in [ahead.shape_a, ahead.shape_b] {
+                            if let Some(sb) = bounds.get(id.index as usize) {
+                                crate::solver::prefetch(sb);
+                            }
+                            if geometry_ahead {
+                                shapes.prefetch_n(id.index, 3);
+                            }
+                        }
+                    }
+                    let (Some(slot), Some(cand), Some(key), Some(out)) = (
+                        slots.get_mut(k),
+                        cands.get_mut(k),
+                        keys.get_mut(k),
+                        outs.get_mut(k),
+                    ) else {
+                        continue;
+                    };
+                    match slot.as_mut() {
+                        Some(c) if !mostly_awake || flag(c.body_a) || flag(c.body_b) => {
+                            update(first + k, c, cand, key, out, &mut collided)
+                        }
+                        _ => *out = (NarrowOutcome::Skipped, false),
+                    }
+                }};
+            }
+            if mostly_awake {
+                for k in 0..len {
+                    visit!(k, Some(k + RECORD_PREFETCH), Some(k + NARROW_PREFETCH));
+                }
+            } else {
+                let slot_of = |j: usize| mine.get(j).map(|&ci| local(ci));
+                for (j, &ci) in mine.iter().enumerate() {
+                    visit!(local(ci), slot_of(j + RECORD_PREFETCH), slot_of(j + NARROW_PREFETCH));
+                }
+            }
+            // The chunk's verdicts filed in its lists, from the dense outcomes just
+            // written (kept out of the loop above, whose pushes slowed it).
+            if let Some(list) = lists_ref.get(first / CONTACT_CHUNK) {
+                let mut list = list.lock().unwrap_or_else(|e| e.into_inner());
+                if mostly_awake {
+                    for (k, &(outcome, solvable)) in outs.iter().enumerate() {
+                        list.note((first + k) as u32, outcome, solvable);
+                    }
+                } else {
+                    for &ci in mine {
+                        if let Some(&(outcome, solvable)) = outs.get(local(ci)) {
+                            list.note(ci, outcome, solvable);
+                        }
+                    }
+                }
+            }
+            collided_total.fetch_add(collided, core::sync::atomic::Ordering::Relaxed);
+        };
+        if owners.len() > 1 {
+            crate::solver::for_each_chunk_mut4_owned(slices, &owners, CONTACT_CHUNK, run);
+        } else {
+            for_each_chunk_mut4(parallel, slices, CONTACT_CHUNK, run);
+        }
         // Of the contacts visited: every slot when mostly awake, else the listed ones.
         let visited = if mostly_awake {
             self.contacts.len()
@@ -1410,6 +1430,28 @@ impl ChunkOutcomes {
 /// Contacts per parallel chunk of the narrow phase and the impulse store.
 const CONTACT_CHUNK: usize = 256;
 
+/// `owners` (where each thread's share of a list starts, ascending from 0, each with its
+/// thread) with each start moved to the nearest multiple of `grid`, so that chunks of
+/// `grid` items cut from the starts stay on the grid; a share left empty is dropped, and
+/// so are all when fewer than two remain.
+fn grid_owners(owners: &[(usize, usize)], grid: usize) -> Vec<(usize, usize)> {
+    let grid = grid.max(1);
+    let mut out: Vec<(usize, usize)> = Vec::with_capacity(owners.len());
+    for &(at, k) in owners {
+        let at = (at + grid / 2) / grid * grid;
+        match out.last() {
+            None if at != 0 => return Vec::new(),
+            Some(&(_, j)) if j == k => {}
+            Some(&(a, _)) if a >= at => {}
+            _ => out.push((at, k)),
+        }
+    }
+    if out.len() < 2 {
+        out.clear();
+    }
+    out
+}
+
 /// How many contacts ahead the narrow phase asks for their bodies and shape bounds.
 const NARROW_PREFETCH: usize = 4;
 
@@ -1604,5 +1646,22 @@ fn rolling_radius(g: &Shape) -> f32 {
         Shape::Capsule(c) => c.radius,
         Shape::Polygon(p) => p.radius(),
         Shape::Segment(_) | Shape::ChainSegment(_) => 0.0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::grid_owners;
+
+    /// Starts move to the nearest grid line; a share that ends up empty, or whose start
+    /// falls on the one before, joins that one; a list that does not start at 0, or has
+    /// fewer than two shares left, gives none.
+    #[test]
+    fn owners_move_to_the_grid() {
+        let owners = [(0, 1), (300, 0), (520, 1), (530, 0), (1000, 1), (1400, 0)];
+        assert_eq!(grid_owners(&owners, 256), vec![(0, 1), (256, 0), (512, 1), (1280, 0)]);
+        assert_eq!(grid_owners(&[(10, 0), (600, 1)], 256), vec![(0, 0), (512, 1)]);
+        assert!(grid_owners(&[(200, 0), (600, 1)], 256).is_empty());
+        assert!(grid_owners(&[(0, 0), (100, 1)], 256).is_empty());
     }
 }
