@@ -121,6 +121,9 @@ pub(crate) struct ContactSolver {
     pub(crate) stored_after: usize,
     /// Runs the last store was cut into (for tests and diagnostics).
     pub(crate) store_runs: usize,
+    /// Steps whose substeps the worker team ran ([`ContactSolver::team_loop`]; for tests
+    /// and diagnostics).
+    pub(crate) team_steps: u64,
     /// Where each thread's share of the contact list starts (ascending starts, the first
     /// at 0, each with its thread; empty on one thread or without a team): the contacts of
     /// the groups each thread solved in the last step, for the next narrow phase to hand
@@ -1222,6 +1225,7 @@ impl ContactSolver {
         if threads < 2 || !self.overflow.is_empty() || !self.groups.is_empty() || self.wide.is_empty() {
             return false;
         }
+        self.team_steps += 1;
         let soft = self.soft;
         let bodies_per_thread = team_bodies_per_thread(sims.len(), threads);
         let colours = self.team_blocks(threads, bodies_per_thread);
@@ -1497,6 +1501,9 @@ impl ContactSolver {
 // The build's entries for the world, `unsafe` for the same reason as the passes above.
 #[allow(unsafe_code, unused_unsafe)]
 impl crate::solver::WideContacts for ContactSolver {
+    fn layout_size(&self) -> (usize, usize) {
+        (self.head.len(), self.ranges.len())
+    }
     fn build_step<S: StateRead + Sync>(
         &mut self,
         ctx: &StepContext,

@@ -930,6 +930,8 @@ pub(crate) trait WideContacts: ConstraintSet {
         contacts: &mut [Option<Contact>],
         sums: &mut [ContactSums],
     );
+    /// The step's layout: its wide groups and its colours.
+    fn layout_size(&self) -> (usize, usize);
 }
 
 /// The contact constraints of the world, in the build of the wide solver it runs: eight

@@ -1649,6 +1649,41 @@ mod tests {
         assert_eq!(reports(&b), before.1);
     }
 
+    /// A small pile on two threads solves its substeps on one (too few groups per colour
+    /// for the team to pay, `World::solve_with`), a large one with the worker team; both
+    /// to the same bits as a one-thread world.
+    #[test]
+    fn only_a_large_pile_shares_its_substeps() {
+        let (mut small, mut alone) = (pyramid_on(20, 2), pyramid_on(20, 1));
+        for _ in 0..30 {
+            small.step(1.0 / 60.0).unwrap();
+            alone.step(1.0 / 60.0).unwrap();
+        }
+        let (groups, colours) = with_contacts!(&small.contact_solver, s => crate::solver::WideContacts::layout_size(s));
+        assert!(
+            groups > 0 && groups < 200 * colours,
+            "{groups} groups in {colours} colours"
+        );
+        assert!(with_contacts!(&small.contact_solver, s => s.team_steps) == 0, "no team");
+        let poses = |w: &World| {
+            w.bodies
+                .iter()
+                .map(|(_, b)| (b.xf.p.x.to_bits(), b.xf.p.y.to_bits()))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(poses(&small), poses(&alone));
+        let (mut large, mut large_alone) = (pyramid_on(100, 2), pyramid_on(100, 1));
+        for _ in 0..10 {
+            large.step(1.0 / 60.0).unwrap();
+            large_alone.step(1.0 / 60.0).unwrap();
+        }
+        assert_eq!(poses(&large), poses(&large_alone));
+        assert!(
+            with_contacts!(&large.contact_solver, s => s.team_steps) > 0,
+            "the team ran"
+        );
+    }
+
     /// With two threads, the build hands a kept layout's groups to the threads that solve
     /// them (`ContactSolver::build_shares`), and the threaded store writes each run's
     /// contacts in place (`ContactSolver::store`):
@@ -1658,7 +1693,9 @@ mod tests {
     /// them all to that serial pass: the results stay right, only slow.)
     #[test]
     fn the_threaded_store_writes_nearly_every_contact_in_place() {
-        let mut w = pyramid_on(70, 2); // over 7 000 contacts: two runs of the store
+        // Over 14 000 contacts: two runs of the store, and enough groups per colour for
+        // the substeps to run on both threads (`World::solve_with`).
+        let mut w = pyramid_on(100, 2);
         for _ in 0..40 {
             w.step(1.0 / 60.0).unwrap();
         }
