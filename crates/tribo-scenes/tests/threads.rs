@@ -66,8 +66,8 @@ fn run(build: fn() -> tribo_scenes::format::SceneFile, workers: u32, steps: u32)
 #[test]
 fn two_and_three_workers_match_one_bit_for_bit() {
     // (scene, steps): long enough for contacts to begin, end, slide and sleep.
-    // (large_pyramid: enough groups per colour for the solver's worker team, which the
-    // smaller scenes leave to one thread.)
+    // (large_pyramid: enough groups per colour for the solver's worker team on two
+    // threads, which the smaller scenes, and it on three, leave to one thread.)
     let cases: [(fn() -> tribo_scenes::format::SceneFile, u32); 6] = [
         (scenes::large_pyramid, 40),
         (scenes::pyramid, 120),

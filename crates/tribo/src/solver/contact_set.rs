@@ -27,8 +27,9 @@
 //! rebuilds what it needs of a lane with [`contact_wide::unpack_full`] and writes the
 //! lane's state back).
 //!
-//! With several threads, the substeps run as one job on every thread ([`team_loop`]):
-//! fixed shares of every colour, spin barriers between colours and stages.
+//! With several threads and enough groups per colour (`World::solve_with`), the substeps
+//! run as one job on every thread ([`team_loop`]): fixed shares of every colour, spin
+//! barriers between colours and stages.
 //!
 //! [`team_loop`]: ContactSolver::team_loop
 
@@ -873,7 +874,9 @@ impl ContactSolver {
     /// (`contacts` is the world's contact list) and its reported sums into `sums` (the
     /// world's `contact_sums`, one per contact slot): each group computes what its lanes
     /// store and writes it straight into their contacts (their first cache line asked for a
-    /// few groups ahead), then the overflow constraints store theirs.
+    /// few groups ahead), then the overflow constraints store theirs. After a step the
+    /// worker team solved, it also notes where each thread's share of the contacts starts
+    /// for the next narrow phase (`contact_owners`).
     ///
     /// With threads, the groups are cut into one run per thread, and the contact list at
     /// the contact of each run's first lane: the contacts follow the solver's layout

@@ -100,7 +100,8 @@ unsafe impl Sync for SharedState {}
 
 /// How the solver reads and writes body states, and how it splits work: one
 /// implementation per step mode, so a single-threaded step works on plain states
-/// ([`Cell`]s over the world's `BodyState`s, no atomics) and a multi-threaded one on
+/// ([`Cell`]s over the world's `BodyState`s, no atomics; also a threaded step whose layout
+/// is too small to share, see `World::solve_with`) and a multi-threaded one on
 /// [`SharedState`]s (relaxed atomics, work split between the pool's threads). The solver
 /// code is generic over it: the physics is written once.
 pub(crate) trait StateRead {
@@ -802,7 +803,8 @@ pub(crate) fn for_each_chunk_mut4<A: Send, B: Send, C: Send, D: Send>(
 /// [`for_each_chunk_mut4`] on threads, with each thread's share given: `owners` lists
 /// where each thread's part of the slices starts (ascending starts, each with its thread;
 /// the first from 0), and each part is cut into chunks of at most `min_len` that its
-/// thread claims first ([`claim_each_share`]). The slices have one length.
+/// thread claims first ([`claim_each_share`]). The slices have one length; without
+/// owners, the first thread's share is all of them.
 pub(crate) fn for_each_chunk_mut4_owned<A: Send, B: Send, C: Send, D: Send>(
     slices: (&mut [A], &mut [B], &mut [C], &mut [D]),
     owners: &[(usize, usize)],
@@ -815,6 +817,7 @@ pub(crate) fn for_each_chunk_mut4_owned<A: Send, B: Send, C: Send, D: Send>(
     let len = a.len().min(b.len()).min(c.len()).min(d.len());
     let mut shares: Vec<Vec<_>> = (0..threads).map(|_| Vec::new()).collect();
     let mut at = 0usize;
+    let owners = if owners.is_empty() { &[(0, 0)][..] } else { owners };
     for (i, &(_, k)) in owners.iter().enumerate() {
         let end = owners.get(i + 1).map_or(len, |o| o.0.min(len));
         while at < end {

@@ -450,16 +450,19 @@ impl World {
         let footprint = core::mem::size_of_val(solver_bodies) + core::mem::size_of_val(bounds);
         let near_ahead = footprint > NEAR_PREFETCH_BYTES;
         let collided_total = core::sync::atomic::AtomicU32::new(0);
-        // On threads, each visits the contacts of the groups it solved last step (the
-        // contacts follow the solver's layout): the candidate and key slots it writes here
-        // are those its own core read in last step's build (`ContactSolver::build_shares`),
-        // rather than lines the other core holds. Cut by count instead, large_pyramid's
-        // two-thread collide took 0.29-0.32 ms against 0.25-0.27 (its set-up unchanged).
+        // On threads, after a step the worker team solved, each visits the contacts of the
+        // groups it solved (the contacts follow the solver's layout): the candidate and key
+        // slots it writes here are those its own core read in last step's build
+        // (`ContactSolver::build_shares`), rather than lines the other core holds. Cut by
+        // count instead (as after a step without the team), large_pyramid's two-thread
+        // collide took 0.29-0.32 ms against 0.25-0.27 (its set-up unchanged).
         let owners = if parallel {
             crate::solver::with_contacts!(&self.contact_solver, s => grid_owners(&s.contact_owners, CONTACT_CHUNK))
         } else {
             Vec::new()
         };
+        // (On the chunks' grid, so that each chunk files into its own list below.)
+        debug_assert!(owners.iter().all(|o| o.0 % CONTACT_CHUNK == 0));
         let slices = (
             self.contacts.as_mut_slice(),
             candidates.as_mut_slice(),
@@ -1441,13 +1444,13 @@ impl ChunkOutcomes {
 const TEAM_MIN_GROUPS_PER_THREAD: usize = 100;
 
 /// Contacts per parallel chunk of the narrow phase and the impulse store.
-const CONTACT_CHUNK: usize = 256;
+pub(super) const CONTACT_CHUNK: usize = 256;
 
 /// `owners` (where each thread's share of a list starts, ascending from 0, each with its
 /// thread) with each start moved to the nearest multiple of `grid`, so that chunks of
 /// `grid` items cut from the starts stay on the grid; a share left empty is dropped, and
-/// so are all when fewer than two remain.
-fn grid_owners(owners: &[(usize, usize)], grid: usize) -> Vec<(usize, usize)> {
+/// so are all when fewer than two remain or the first start does not round to 0.
+pub(super) fn grid_owners(owners: &[(usize, usize)], grid: usize) -> Vec<(usize, usize)> {
     let grid = grid.max(1);
     let mut out: Vec<(usize, usize)> = Vec::with_capacity(owners.len());
     for &(at, k) in owners {
@@ -1667,8 +1670,8 @@ mod tests {
     use super::grid_owners;
 
     /// Starts move to the nearest grid line; a share that ends up empty, or whose start
-    /// falls on the one before, joins that one; a list that does not start at 0, or has
-    /// fewer than two shares left, gives none.
+    /// falls on the one before, joins that one; a list whose first start does not round
+    /// to 0, or that has fewer than two shares left, gives none.
     #[test]
     fn owners_move_to_the_grid() {
         let owners = [(0, 1), (300, 0), (520, 1), (530, 0), (1000, 1), (1400, 0)];
