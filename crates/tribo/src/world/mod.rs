@@ -257,6 +257,9 @@ pub struct World {
     /// Scratch of a parallel finalize: per solver slot, whether its body's one shape got
     /// its next box (inside the fat box) in the parallel pass (see `World::finalize`).
     pub(crate) scratch_fitted: Vec<core::sync::atomic::AtomicBool>,
+    /// The last parallel finalize left more than half its bodies to its serial pass: the
+    /// next ones run on one thread (see `World::finalize`).
+    pub(crate) finalize_alone: bool,
     /// Per solver slot: touched something this step (`finalize`'s sweep rule).
     pub(crate) scratch_touched: Vec<bool>,
     /// Solved bodies per chunk of body slots in the last parallel body pass (its guess
@@ -356,6 +359,7 @@ impl World {
             scratch_flags: Vec::new(),
             mostly_awake: false,
             scratch_fitted: Vec::new(),
+            finalize_alone: false,
             scratch_touched: Vec::new(),
             scratch_chunk_counts: Vec::new(),
             body_pass_retries: 0,
@@ -1688,6 +1692,39 @@ mod tests {
             with_contacts!(&large.contact_solver, s => s.team_steps) > 0,
             "the team ran ({groups} groups in {colours} colours)"
         );
+    }
+
+    /// On two threads, a cloud of boxes falling fast (each leaves its fat box every step)
+    /// is finalized on one thread after the first parallel finalize finds that out, and a
+    /// resting pyramid in parallel; the falling boxes end where a one-thread world puts
+    /// them, to the bit.
+    #[test]
+    fn a_finalize_that_moves_every_box_runs_on_one_thread() {
+        let cloud = |workers: u32| {
+            let (mut w, _) = sleepless_with_ground_on(workers);
+            let cube = Shape::Polygon(Polygon::new_box(0.25, 0.25).unwrap());
+            for i in 0..400 {
+                let at = Vec2::new((i % 20) as f32 * 2.0, 500.0 + (i / 20) as f32 * 2.0);
+                let b = w.create_body(&BodyDef::dynamic(at)).unwrap();
+                w.create_shape(b, &ShapeDef::default(), &cube).unwrap();
+            }
+            for _ in 0..60 {
+                w.step(1.0 / 60.0).unwrap();
+            }
+            w
+        };
+        let (two, one) = (cloud(2), cloud(1));
+        assert!(two.finalize_alone, "the falling boxes left their fat boxes");
+        let ys = |w: &World| w.bodies.iter().map(|(_, b)| b.xf.p.y.to_bits()).collect::<Vec<_>>();
+        assert_eq!(ys(&two), ys(&one));
+        // Falling freely for a second: g t = 9.8 m/s down (so they did move).
+        let falling = |b: &Body| b.body_type == BodyType::Static || b.v.y < -9.0;
+        assert!(one.bodies.iter().all(|(_, b)| falling(b)));
+        let mut pile = pyramid_on(20, 2);
+        for _ in 0..20 {
+            pile.step(1.0 / 60.0).unwrap();
+        }
+        assert!(!pile.finalize_alone, "a resting pile's boxes stay in their fat boxes");
     }
 
     /// With two threads, the build hands a kept layout's groups to the threads that solve
