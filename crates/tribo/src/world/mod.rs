@@ -257,9 +257,13 @@ pub struct World {
     /// Scratch of a parallel finalize: per solver slot, whether its body's one shape got
     /// its next box (inside the fat box) in the parallel pass (see `World::finalize`).
     pub(crate) scratch_fitted: Vec<core::sync::atomic::AtomicBool>,
-    /// The last parallel finalize left more than half its bodies to its serial pass: the
-    /// next ones run on one thread (see `World::finalize`).
+    /// The last parallel finalize left more than half its bodies to its serial pass
+    /// (boxes that left their fat boxes; bodies of several shapes, or none): the next ones
+    /// run on one thread, the parallel one tried again every 16 steps (see
+    /// `World::finalize`).
     pub(crate) finalize_alone: bool,
+    /// Finalizes of a threaded world run on one thread (`finalize_alone`; for tests).
+    pub(crate) alone_finalizes: u64,
     /// Per solver slot: touched something this step (`finalize`'s sweep rule).
     pub(crate) scratch_touched: Vec<bool>,
     /// Solved bodies per chunk of body slots in the last parallel body pass (its guess
@@ -360,6 +364,7 @@ impl World {
             mostly_awake: false,
             scratch_fitted: Vec::new(),
             finalize_alone: false,
+            alone_finalizes: 0,
             scratch_touched: Vec::new(),
             scratch_chunk_counts: Vec::new(),
             body_pass_retries: 0,
@@ -1695,9 +1700,9 @@ mod tests {
     }
 
     /// On two threads, a cloud of boxes falling fast (each leaves its fat box every step)
-    /// is finalized on one thread after the first parallel finalize finds that out, and a
-    /// resting pyramid in parallel; the falling boxes end where a one-thread world puts
-    /// them, to the bit.
+    /// is finalized on one thread once a parallel finalize finds that out, and a resting
+    /// pyramid in parallel; the falling boxes end where a one-thread world puts them, to
+    /// the bit.
     #[test]
     fn a_finalize_that_moves_every_box_runs_on_one_thread() {
         let cloud = |workers: u32| {
@@ -1715,6 +1720,11 @@ mod tests {
         };
         let (two, one) = (cloud(2), cloud(1));
         assert!(two.finalize_alone, "the falling boxes left their fat boxes");
+        assert!(
+            two.alone_finalizes > 10,
+            "{} finalizes on one thread",
+            two.alone_finalizes
+        );
         let ys = |w: &World| w.bodies.iter().map(|(_, b)| b.xf.p.y.to_bits()).collect::<Vec<_>>();
         assert_eq!(ys(&two), ys(&one));
         // Falling freely for a second: g t = 9.8 m/s down (so they did move).
@@ -1725,6 +1735,7 @@ mod tests {
             pile.step(1.0 / 60.0).unwrap();
         }
         assert!(!pile.finalize_alone, "a resting pile's boxes stay in their fat boxes");
+        assert_eq!(pile.alone_finalizes, 0);
     }
 
     /// With two threads, the build hands a kept layout's groups to the threads that solve
