@@ -778,26 +778,30 @@ pub(crate) fn for_each_mut2<A: Send, B: Send>(
 
 /// [`for_each_mut`] over four slices by chunks of `min_len`: `f(first, a, b, c, d)` gets a
 /// chunk of each slice (its first element at index `first`), so it can look ahead inside
-/// the chunk. One chunk on one thread.
+/// the chunk. One chunk on one thread; on threads, thread `k` claims the `k`-th run of
+/// chunks first, as [`claim_each`] shares them out.
 pub(crate) fn for_each_chunk_mut4<A: Send, B: Send, C: Send, D: Send>(
     parallel: bool,
     slices: (&mut [A], &mut [B], &mut [C], &mut [D]),
     min_len: usize,
     f: impl Fn(usize, &mut [A], &mut [B], &mut [C], &mut [D]) + Sync,
 ) {
-    let (a, b, c, d) = slices;
-    if parallel {
-        let n = min_len.max(1);
-        let chunks = a
-            .chunks_mut(n)
-            .zip(b.chunks_mut(n))
-            .zip(c.chunks_mut(n))
-            .zip(d.chunks_mut(n))
-            .enumerate();
-        claim_each(true, chunks, |(k, (((w, x), y), z))| f(k * n, w, x, y, z));
-    } else {
+    if !parallel {
+        let (a, b, c, d) = slices;
         f(0, a, b, c, d);
+        return;
     }
+    let n = min_len.max(1);
+    let len = slices
+        .0
+        .len()
+        .min(slices.1.len())
+        .min(slices.2.len())
+        .min(slices.3.len());
+    let chunks = len.div_ceil(n);
+    let shares = rayon::current_num_threads().min(chunks).max(1);
+    let owners: Vec<(usize, usize)> = (0..shares).map(|k| (k * chunks / shares * n, k)).collect();
+    for_each_chunk_mut4_owned(slices, &owners, n, f);
 }
 
 /// [`for_each_chunk_mut4`] on threads, with each thread's share given: `owners` lists

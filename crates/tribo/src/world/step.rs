@@ -980,11 +980,11 @@ impl World {
     ///
     /// With threads, when the last parallel finalize left more than half its bodies to the
     /// serial pass (bodies whose boxes leave their fat boxes every step, or of several
-    /// shapes or none), the finalize runs
-    /// on one thread, trying the parallel one again every [`FINALIZE_RETRY`] steps: the
-    /// serial pass then read again, on the stepping thread, every record the other thread
-    /// had just written (joint_grid's falling grid: 0.79 ms on two threads against 0.60 on
-    /// one; large_pyramid's, whose boxes stay put, 0.11 against 0.20). Same results.
+    /// shapes or none), the finalize runs on one thread, trying the parallel one again
+    /// every [`FINALIZE_RETRY`] steps: the serial pass then read again, on the stepping
+    /// thread, every record the other thread had just written (joint_grid's falling grid:
+    /// 0.79 ms on two threads against 0.60 on one; large_pyramid's, whose boxes stay put,
+    /// 0.11 against 0.20). Same results.
     fn finalize(&mut self, dt: f32, parallel: bool) {
         if !parallel || (self.finalize_alone && self.step_count % FINALIZE_RETRY != 0) {
             if parallel {
