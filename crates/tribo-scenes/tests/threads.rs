@@ -67,9 +67,11 @@ fn run(build: fn() -> tribo_scenes::format::SceneFile, workers: u32, steps: u32)
 fn two_and_three_workers_match_one_bit_for_bit() {
     // (scene, steps): long enough for contacts to begin, end, slide and sleep.
     // (large_pyramid: enough groups per colour for the solver's worker team on two
-    // threads, which the smaller scenes, and it on three, leave to one thread.)
-    let cases: [(fn() -> tribo_scenes::format::SceneFile, u32); 6] = [
+    // threads, which the smaller scenes, and it on three, leave to one thread;
+    // joint_grid: enough blocks of joints per colour to share its joint passes.)
+    let cases: [(fn() -> tribo_scenes::format::SceneFile, u32); 7] = [
         (scenes::large_pyramid, 40),
+        (scenes::joint_grid, 20),
         (scenes::pyramid, 120),
         (scenes::dominoes, 150),
         (scenes::tumbler, 150),

@@ -107,7 +107,10 @@ pub(crate) fn joint_angle(q_a: Rot, q_b: Rot, reference: f32) -> f32 {
 }
 
 impl JointConstraint {
-    /// Prepares a joint for the step.
+    /// Prepares a joint for the step. (Inlined into its one caller, the build, which
+    /// then writes the constraint in place: called, it returned the 150-byte record
+    /// through a copy.)
+    #[inline(always)]
     pub fn new(slot: u32, j: &JointRecord, a: &JointBody, b: &JointBody, ctx: &StepContext) -> JointConstraint {
         let d = &j.def;
         let hertz = d.constraint_hertz.min(0.25 * ctx.inv_h);
@@ -201,6 +204,7 @@ impl JointConstraint {
     }
 
     /// Re-applies the accumulated impulses at the start of a substep.
+    #[inline(always)]
     pub fn warm_start<S: StateCell>(&self, states: &[S]) {
         let (mut a, mut b) = self.load(states);
         let j = &self.impulses;
@@ -216,6 +220,7 @@ impl JointConstraint {
     }
 
     /// One pass over the joint's rows (see the module docs); `use_bias`: the biased pass.
+    #[inline(always)]
     pub fn solve<S: StateCell>(&mut self, states: &[S], ctx: &StepContext, use_bias: bool) {
         let (mut a, mut b) = self.load(states);
         let k = self.axial_mass;
@@ -320,6 +325,31 @@ struct Body {
 const ORDER_WINDOW: usize = 16;
 const _: () = assert!(ORDER_WINDOW <= 32); // colours are bits of a u32
 
+/// Joints per block of the threaded passes (a multiple of [`ORDER_WINDOW`], so a block
+/// holds whole windows of the solve order): consecutive joints in slot order, coloured so
+/// that the blocks of one colour write no body in common ([`JointSolver::order_joints`]).
+const JOINT_BLOCK: usize = 256;
+const _: () = assert!(JOINT_BLOCK % ORDER_WINDOW == 0);
+
+/// Fewest joint blocks per thread and colour, on average, for which the step shares its
+/// substeps between threads ([`JointSolver::worth_sharing`]).
+const MIN_BLOCKS_PER_THREAD: usize = 2;
+
+/// Block colours: 0 … `BLOCK_COLOURS − 2` are shared between threads; a block that finds
+/// them all taken by blocks writing its bodies gets the last, whose blocks run one after
+/// the other on one thread.
+const BLOCK_COLOURS: usize = 32;
+const SERIAL_BLOCKS: usize = BLOCK_COLOURS - 1;
+
+/// What a pass over the joints does ([`JointSolver::pass`]).
+#[derive(Clone, Copy)]
+enum JointPass {
+    /// Re-applies the accumulated impulses.
+    WarmStart,
+    /// Solves the rows; `use_bias`: the biased pass.
+    Solve { use_bias: bool },
+}
+
 /// The joints of one step, prepared.
 #[derive(Default)]
 pub(crate) struct JointSolver {
@@ -334,8 +364,17 @@ pub(crate) struct JointSolver {
     /// The same for this step's constraints (filled by [`JointSolver::push`]).
     writes: Vec<[u32; 2]>,
     /// Scratch of the colouring: per solver state, the colours its joints took in the
-    /// current window (all zero between windows).
+    /// current window, or its blocks (all zero between colourings).
     used: Vec<u32>,
+    /// The blocks of [`JOINT_BLOCK`] constraints colour by colour (in block order within
+    /// a colour), and where each colour's blocks end in it.
+    block_order: Vec<u32>,
+    colour_ends: Vec<usize>,
+    /// The index in `colour_ends` of the colour whose blocks run on one thread (see
+    /// [`SERIAL_BLOCKS`]); `usize::MAX` when no block has it.
+    serial_from: usize,
+    /// Passes whose colours were shared between threads (a count for tests).
+    pub shared_passes: u64,
 }
 
 impl JointSolver {
@@ -418,23 +457,143 @@ impl JointSolver {
                 }
             }
         }
+        self.colour_blocks();
     }
 
-    /// Re-applies every joint's impulses, in slot order (a short pass that gained nothing
-    /// from the solve order: joint_grid's warm start took 0.50 ms in slot order, 0.69 in
-    /// the solve order).
-    pub fn warm_start<S: StateCell>(&mut self, states: &[S]) {
-        for j in &self.constraints {
-            j.warm_start(states);
-        }
-    }
-
-    pub fn solve<S: StateCell>(&mut self, states: &[S], ctx: &StepContext, use_bias: bool) {
-        for &k in &self.order {
-            if let Some(j) = self.constraints.get_mut(k as usize) {
-                j.solve(states, ctx, use_bias);
+    /// Colours the blocks of [`JOINT_BLOCK`] joints as the windows' joints are coloured
+    /// (greedily in block order, the lowest colour in which no block writes one of its
+    /// bodies), into `block_order` and `colour_ends`. The passes run colour after colour,
+    /// and with threads share out each colour's blocks: blocks of one colour write no body
+    /// in common (a joint writes both its bodies unless one is static, kinematic or
+    /// asleep, which no joint writes), so they may run in any order and on any thread with
+    /// the same result. Below two blocks (255 joints or fewer) there is one colour and the
+    /// order is the windows' alone. Box2D v3 colours its joints one by one with its
+    /// contacts; whole blocks keep the windows' order inside, whose joints are read within
+    /// a few kilobytes of each other (see [`ORDER_WINDOW`]).
+    fn colour_blocks(&mut self) {
+        let used = &mut self.used;
+        let colours: Vec<u8> = self
+            .order_bodies
+            .chunks(JOINT_BLOCK)
+            .map(|block| {
+                let written = || block.iter().flatten().filter(|&&i| i != 0);
+                let busy = written().fold(0u32, |m, &i| m | used.get(i as usize).copied().unwrap_or(0));
+                let colour = (!busy).trailing_zeros().min(SERIAL_BLOCKS as u32);
+                if colour < SERIAL_BLOCKS as u32 {
+                    for &i in written() {
+                        if let Some(u) = used.get_mut(i as usize) {
+                            *u |= 1 << colour;
+                        }
+                    }
+                }
+                colour as u8
+            })
+            .collect();
+        for &i in self.order_bodies.iter().flatten() {
+            if let Some(u) = used.get_mut(i as usize) {
+                *u = 0;
             }
         }
+        self.block_order.clear();
+        self.colour_ends.clear();
+        let top = colours.iter().copied().max().map_or(0, |c| c as usize + 1);
+        for c in 0..top {
+            let at = self.block_order.len();
+            self.block_order
+                .extend((0..colours.len() as u32).filter(|&b| colours[b as usize] as usize == c));
+            if self.block_order.len() > at {
+                self.colour_ends.push(self.block_order.len());
+            }
+        }
+        // (The serial colour, if used, is the last one; its blocks are marked by it.)
+        self.serial_from = if colours.iter().any(|&c| c as usize == SERIAL_BLOCKS) {
+            self.colour_ends.len() - 1
+        } else {
+            usize::MAX
+        };
+    }
+
+    /// Whether the passes would give each of `threads` threads at least
+    /// [`MIN_BLOCKS_PER_THREAD`] blocks of every shared colour, on average.
+    pub fn worth_sharing(&self, threads: usize) -> bool {
+        let shared = self.colour_ends.len().min(self.serial_from);
+        let blocks = self.colour_ends.get(shared.wrapping_sub(1)).copied().unwrap_or(0);
+        shared > 0 && blocks >= MIN_BLOCKS_PER_THREAD * threads * shared
+    }
+
+    /// Runs `pass` on every constraint, block colour after block colour (see
+    /// [`JointSolver::colour_blocks`]); within a block in slot order (the warm start) or in
+    /// the solve order. (A pass, not a closure: called through a closure, each joint's
+    /// rows were a call of their own.) With shared states (the threaded step), each colour's blocks are shared
+    /// between the pool's threads, the serial colour's run on this thread.
+    fn pass<S: StateCell>(&mut self, states: &[S], ctx: &StepContext, pass: JointPass) {
+        let order = &self.order;
+        let run = |b: usize, block: &mut [JointConstraint], states: &[S]| {
+            let base = b * JOINT_BLOCK;
+            match pass {
+                JointPass::WarmStart => {
+                    for j in block.iter() {
+                        j.warm_start(states);
+                    }
+                }
+                JointPass::Solve { use_bias } => {
+                    for &k in order.get(base..base + block.len()).unwrap_or(&[]) {
+                        if let Some(j) = block.get_mut((k as usize).wrapping_sub(base)) {
+                            j.solve(states, ctx, use_bias);
+                        }
+                    }
+                }
+            }
+        };
+        if self.colour_ends.len() <= 1 || S::as_shared(states).is_none() {
+            // One colour, or one thread: the blocks in the same order, here.
+            let mut start = 0;
+            for &end in &self.colour_ends {
+                for &b in self.block_order.get(start..end).unwrap_or(&[]) {
+                    let b = b as usize;
+                    let first = b * JOINT_BLOCK;
+                    let last = (first + JOINT_BLOCK).min(self.constraints.len());
+                    if let Some(block) = self.constraints.get_mut(first..last) {
+                        run(b, block, states);
+                    }
+                }
+                start = end;
+            }
+            return;
+        }
+        self.shared_passes += 1;
+        let mut blocks: Vec<Option<&mut [JointConstraint]>> =
+            self.constraints.chunks_mut(JOINT_BLOCK).map(Some).collect();
+        let mut start = 0;
+        for (c, &end) in self.colour_ends.iter().enumerate() {
+            let mut items: Vec<(usize, &mut [JointConstraint])> = self
+                .block_order
+                .get(start..end)
+                .unwrap_or(&[])
+                .iter()
+                .filter_map(|&b| blocks.get_mut(b as usize)?.take().map(|block| (b as usize, block)))
+                .collect();
+            start = end;
+            if c >= self.serial_from {
+                for (b, block) in items {
+                    run(b, block, states);
+                }
+            } else {
+                S::for_each_mut(states, &mut items, 1, |_, (b, block), states| run(*b, block, states));
+            }
+        }
+    }
+
+    /// Re-applies every joint's impulses, block colour after block colour, in slot order
+    /// within a block (a short pass that gained nothing from the solve order: joint_grid's
+    /// warm start took 0.50 ms in slot order, 0.69 in the solve order).
+    pub fn warm_start<S: StateCell>(&mut self, states: &[S], ctx: &StepContext) {
+        self.pass(states, ctx, JointPass::WarmStart);
+    }
+
+    /// One pass over every joint's rows, in the solve order (see [`JointSolver::pass`]).
+    pub fn solve<S: StateCell>(&mut self, states: &[S], ctx: &StepContext, use_bias: bool) {
+        self.pass(states, ctx, JointPass::Solve { use_bias });
     }
 }
 
@@ -531,6 +690,66 @@ mod tests {
         }
         js.order_joints(101);
         assert_eq!(js.order, (0..100).collect::<Vec<u32>>(), "one colour: slot order");
+    }
+
+    /// The blocks' colours: every block once; no two blocks of a shared colour write the
+    /// same state; blocks that find every shared colour taken go last, to one thread. A
+    /// chain's blocks share one state with the next block, so they alternate between two
+    /// colours; 40 blocks that each hold a joint to one hub state take the 31 shared
+    /// colours, then the serial one.
+    #[test]
+    fn blocks_of_one_colour_write_no_state_in_common() {
+        let check = |js: &JointSolver| {
+            let mut seen = js.block_order.clone();
+            seen.sort_unstable();
+            let blocks = js.constraints.len().div_ceil(JOINT_BLOCK) as u32;
+            assert_eq!(seen, (0..blocks).collect::<Vec<u32>>(), "every block once");
+            let mut start = 0;
+            for (c, &end) in js.colour_ends.iter().enumerate() {
+                let mut writer = std::collections::HashMap::new();
+                for &b in &js.block_order[start..end] {
+                    let first = b as usize * JOINT_BLOCK;
+                    for bodies in js.order_bodies.iter().skip(first).take(JOINT_BLOCK) {
+                        for &i in bodies.iter().filter(|&&i| i != 0) {
+                            let w = *writer.entry(i).or_insert(b);
+                            assert!(
+                                w == b || c >= js.serial_from,
+                                "colour {c}: blocks {w} and {b} write state {i}"
+                            );
+                        }
+                    }
+                }
+                start = end;
+            }
+        };
+        let mut js = JointSolver::default();
+        for k in 0..1000u32 {
+            js.push(between(k, k + 1, k + 2));
+        }
+        js.order_joints(1002);
+        check(&js);
+        assert_eq!(js.colour_ends, vec![2, 4], "a chain's blocks alternate");
+        assert_eq!(js.block_order, vec![0, 2, 1, 3]);
+        assert_eq!(js.serial_from, usize::MAX);
+        assert!(js.worth_sharing(1) && !js.worth_sharing(2), "2 blocks a colour");
+        let mut hub = JointSolver::default();
+        for k in 0..40 * JOINT_BLOCK as u32 {
+            // The first joint of each block holds state 1 (the hub); the others, a
+            // static side and a state of their own.
+            let a = if k as usize % JOINT_BLOCK == 0 { 1 } else { 0 };
+            hub.push(between(k, a, k + 2));
+        }
+        hub.order_joints(40 * JOINT_BLOCK + 2);
+        check(&hub);
+        assert_eq!(
+            hub.colour_ends.len(),
+            BLOCK_COLOURS,
+            "31 shared colours and the serial one"
+        );
+        assert_eq!(hub.serial_from, SERIAL_BLOCKS);
+        assert_eq!(&hub.block_order[SERIAL_BLOCKS..], &(31..40).collect::<Vec<u32>>()[..]);
+        assert!(!hub.worth_sharing(1), "one block a colour");
+        assert!(hub.used.iter().all(|&u| u == 0), "the scratch is left clear");
     }
 
     #[test]

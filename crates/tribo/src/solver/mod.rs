@@ -888,7 +888,7 @@ impl<K: ConstraintSet> ConstraintSet for StepConstraints<'_, K> {
         self.contacts.estimate_new_contacts(ctx, trial)
     }
     fn warm_start<C: StateCell>(&mut self, ctx: &StepContext, states: &[C]) {
-        self.joints.warm_start(states);
+        self.joints.warm_start(states, ctx);
         self.contacts.warm_start(ctx, states);
     }
     fn solve<C: StateCell>(&mut self, ctx: &StepContext, states: &[C], use_bias: bool, elapsed: f32) {

@@ -1699,6 +1699,74 @@ mod tests {
         );
     }
 
+    /// A hanging grid of 40 × 40 disks on 3 120 revolute joints (its top row pinned, as in
+    /// Box2D's joint_grid) shares its joint passes between two threads, block colour by
+    /// block colour, and ends to the bit where a one-thread world puts it. The joints hold:
+    /// each pivot's two anchors stay within 1 cm (the soft joints give millimetres under a
+    /// 39-disk column), and the grid hangs from its pins (its lowest disk 39 m down, the
+    /// length of a column, within 0.5 m).
+    #[test]
+    fn a_hanging_grid_shares_its_joints_between_threads_to_the_same_bits() {
+        let grid = |workers: u32| {
+            let (mut w, ground) = sleepless_with_ground_on(workers);
+            let n = 40;
+            let disk = Shape::Circle(crate::geometry::Circle::new(Vec2::ZERO, 0.4).unwrap());
+            // Neighbours do not collide (their joints hold them), as in joint_grid.
+            let def = ShapeDef {
+                filter: Filter {
+                    category: 2,
+                    mask: !2,
+                    group: 0,
+                },
+                ..ShapeDef::default()
+            };
+            let mut ids: Vec<BodyId> = Vec::new();
+            for k in 0..n {
+                for i in 0..n {
+                    let at = Vec2::new(k as f32, -(i as f32));
+                    let b = if i == 0 {
+                        ground
+                    } else {
+                        let b = w.create_body(&BodyDef::dynamic(at)).unwrap();
+                        w.create_shape(b, &def, &disk).unwrap();
+                        let up = ids[ids.len() - 1];
+                        let joint = crate::dynamics::RevoluteJointDef::at(&w, up, b, at + Vec2::new(0.0, 0.5)).unwrap();
+                        w.create_revolute_joint(&joint).unwrap();
+                        if k > 0 {
+                            let left = ids[ids.len() - n];
+                            let joint =
+                                crate::dynamics::RevoluteJointDef::at(&w, left, b, at - Vec2::new(0.5, 0.0)).unwrap();
+                            w.create_revolute_joint(&joint).unwrap();
+                        }
+                        b
+                    };
+                    ids.push(b);
+                }
+            }
+            for _ in 0..30 {
+                w.step(1.0 / 60.0).unwrap();
+            }
+            w
+        };
+        let (two, one) = (grid(2), grid(1));
+        assert!(one.joint_count() > 3000, "{} joints", one.joint_count());
+        assert!(two.joint_solver.shared_passes > 0, "the joint passes were shared");
+        assert_eq!(one.joint_solver.shared_passes, 0);
+        let poses = |w: &World| {
+            w.bodies
+                .iter()
+                .map(|(_, b)| [b.xf.p.x, b.xf.p.y, b.xf.q.c, b.xf.q.s, b.v.x, b.v.y, b.w].map(f32::to_bits))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(poses(&two), poses(&one));
+        for id in one.joint_ids() {
+            let (a, b) = one.joint_world_anchors(id).unwrap();
+            assert!((a - b).length() < 0.01, "joint {id:?}: anchors {a:?} and {b:?} apart");
+        }
+        let lowest = one.bodies.iter().map(|(_, b)| -b.xf.p.y).fold(0.0f32, f32::max);
+        assert!((lowest - 39.0).abs() < 0.5, "the lowest disk hangs {lowest} m down");
+    }
+
     /// On two threads, a cloud of boxes falling fast (each leaves its fat box every step)
     /// is finalized on one thread once a parallel finalize finds that out, and a resting
     /// pyramid in parallel; the falling boxes end where a one-thread world puts them, to

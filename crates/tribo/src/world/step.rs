@@ -934,7 +934,9 @@ impl World {
         // Either way the results are the same to the bit.
         let (groups, colours) = set.contacts.layout_size();
         let threads = rayon::current_num_threads();
-        if ctx.parallel && groups >= TEAM_MIN_GROUPS_PER_THREAD * threads * colours {
+        if ctx.parallel
+            && (groups >= TEAM_MIN_GROUPS_PER_THREAD * threads * colours || set.joints.worth_sharing(threads))
+        {
             // Threads share the states in place (`SharedState`, 32 bytes each).
             let shared = SharedState::from_mut_slice(&mut self.states);
             solve_step(ctx, &self.sims, shared, &mut set, &mut self.profile);
