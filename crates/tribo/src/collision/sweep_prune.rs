@@ -44,6 +44,10 @@ const BAND_BOXES: f32 = 4.0;
 /// At most this many bands.
 const MAX_BANDS: u32 = 1024;
 
+/// Fewest entries per thread for which the sweep is shared between threads (fewer: one
+/// thread sweeps them all).
+const MIN_PART_ENTRIES: usize = 2048;
+
 /// The bands across the sweep axis: `of(c)` is the band of cross coordinate `c` [m],
 /// non-decreasing in `c` (so a box meets every band from that of its lower bound to that of
 /// its upper one).
@@ -106,10 +110,15 @@ pub(crate) struct SweepPrune {
     hits: Vec<u32>,
     /// Sweeps left to skip after one gave up.
     back_off: u32,
-    /// Sweeps made, sweeps that gave up, and the most bands a sweep cut (tests read these).
+    /// Sweeps made, sweeps that gave up, the most bands a sweep cut, and sweeps shared
+    /// between threads (tests read these).
     pub sweeps: u64,
     pub gave_up: u64,
     pub most_bands: u32,
+    pub shared_sweeps: u64,
+    /// The tests' [`MIN_PART_ENTRIES`] (0: that one), so that small sets are shared too.
+    #[cfg(test)]
+    min_part: usize,
 }
 
 /// `x`'s bits as an unsigned integer in the order of the floats (negative floats' bits
@@ -131,8 +140,13 @@ impl SweepPrune {
     /// Returns false, with `out` as it was, when the sweep is not worth it: it would test
     /// more than [`MAX_TESTS_PER_BOX`] candidates a box (and then for the next
     /// [`BACK_OFF_SWEEPS`] calls); the caller then walks the tree.
+    /// With `threads` > 1 (inside the pool that has them), the sweep of step 3 is shared:
+    /// the bands cut into one run of whole bands per thread, of about as many entries
+    /// each, each run swept with its share of the test budget into a list of its own. The
+    /// pairs are the same; only whether the sweep gives up may differ (a run over its
+    /// share), and then the caller's walk finds them.
     #[inline(never)]
-    pub fn moved_pairs(&mut self, tree: &DynamicTree, moved: &[bool], out: &mut Vec<u64>) -> bool {
+    pub fn moved_pairs(&mut self, tree: &DynamicTree, moved: &[bool], threads: usize, out: &mut Vec<u64>) -> bool {
         if self.back_off > 0 {
             self.back_off -= 1;
             return false;
@@ -269,23 +283,104 @@ impl SweepPrune {
                 self.first.push(PADDING);
             }
         }
-        // 3. Sweep ([`sweep_sorted`]).
+        // 3. Sweep ([`sweep_sorted`]), in runs of whole bands on threads.
         let start = out.len();
-        let swept = sweep_sorted(
-            [&self.lo, &self.hi, &self.cross_lo, &self.cross_hi],
-            &self.data,
-            &self.moved,
-            [&self.band, &self.first],
-            MAX_TESTS_PER_BOX * n,
-            &mut self.hits,
-            out,
-        );
+        let budget = MAX_TESTS_PER_BOX * n;
+        let runs = self.runs(threads, entries);
+        let swept = if runs.len() < 2 {
+            sweep_sorted(
+                [&self.lo, &self.hi, &self.cross_lo, &self.cross_hi],
+                &self.data,
+                &self.moved,
+                [&self.band, &self.first],
+                budget,
+                &mut self.hits,
+                out,
+            )
+        } else {
+            self.shared_sweeps += 1;
+            let mut found: Vec<(Vec<u64>, bool)> = vec![(Vec::new(), true); runs.len()];
+            let this = &*self;
+            crate::solver::claim_each(true, runs.iter().zip(found.iter_mut()), |(run, (pairs, ok))| {
+                fn part<'a, T>(v: &'a [T], run: &SweepRun) -> &'a [T] {
+                    v.get(run.start..run.end).unwrap_or(&[])
+                }
+                // (Its share of the budget, by its share of the entries, rounded up.)
+                let share = (budget * run.entries).div_ceil(entries.max(1));
+                *ok = sweep_sorted(
+                    [&this.lo, &this.hi, &this.cross_lo, &this.cross_hi].map(|v| part(v, run)),
+                    part(&this.data, run),
+                    part(&this.moved, run),
+                    [part(&this.band, run), part(&this.first, run)],
+                    share,
+                    &mut Vec::new(),
+                    pairs,
+                );
+            });
+            let ok = found.iter().all(|f| f.1);
+            for (pairs, _) in found {
+                out.extend(pairs);
+            }
+            ok
+        };
         if !swept {
             out.truncate(start);
             self.back_off = BACK_OFF_SWEEPS;
             self.gave_up += 1;
         }
         swept
+    }
+}
+
+/// A run of whole bands of the sweep arrays (their places, padding included) and how
+/// many entries it holds ([`SweepPrune::runs`]).
+struct SweepRun {
+    start: usize,
+    end: usize,
+    entries: usize,
+}
+
+impl SweepPrune {
+    /// The bands cut into `threads` runs of consecutive whole bands of about equal
+    /// entries (each band's entries followed by its padding, as laid out), or one run
+    /// when there are fewer than [`MIN_PART_ENTRIES`] entries a thread (`entries` in all).
+    fn runs(&self, threads: usize, entries: usize) -> Vec<SweepRun> {
+        #[cfg(test)]
+        let min_part = if self.min_part > 0 {
+            self.min_part
+        } else {
+            MIN_PART_ENTRIES
+        };
+        #[cfg(not(test))]
+        let min_part = MIN_PART_ENTRIES;
+        let bands = self.starts.len().saturating_sub(1);
+        // Band k's entries start at place starts[k] + k · CHUNK (the padding before it).
+        let place = |k: usize| self.starts.get(k).map_or(0, |&s| s as usize) + k * CHUNK;
+        let count = |k: usize| self.starts.get(k).map_or(0, |&s| s as usize);
+        let parts = threads.min(entries / min_part.max(1)).min(bands);
+        if parts < 2 {
+            return Vec::new();
+        }
+        let mut runs = Vec::with_capacity(parts);
+        let mut from = 0usize;
+        for p in 1..=parts {
+            // The first band at or past this run's share of the entries (the last run: all).
+            let target = p * entries / parts;
+            let mut to = from + 1;
+            while to < bands && (count(to) < target || p == parts) {
+                to += 1;
+            }
+            runs.push(SweepRun {
+                start: place(from),
+                end: place(to),
+                entries: count(to) - count(from),
+            });
+            from = to;
+            if from >= bands {
+                break;
+            }
+        }
+        runs
     }
 }
 
@@ -420,18 +515,28 @@ mod tests {
 
     /// The sweep's pairs (sorted) and how many bands it cut, or None when it gave up.
     fn swept(boxes: &[(Aabb, bool)]) -> Option<(Vec<u64>, u32)> {
+        swept_on(boxes, 1).map(|(pairs, bands, _)| (pairs, bands))
+    }
+
+    /// [`swept`] on `threads` threads of a pool of its own, sharing any set of more than
+    /// eight entries a thread, and whether it did.
+    fn swept_on(boxes: &[(Aabb, bool)], threads: usize) -> Option<(Vec<u64>, u32, bool)> {
         let mut tree = DynamicTree::new();
         for (i, (b, _)) in boxes.iter().enumerate() {
             tree.create_proxy(*b, 1, i as u64);
         }
         let moved: Vec<bool> = boxes.iter().map(|b| b.1).collect();
-        let mut sp = SweepPrune::default();
+        let mut sp = SweepPrune {
+            min_part: 8,
+            ..SweepPrune::default()
+        };
         let mut out = vec![7];
-        let ok = sp.moved_pairs(&tree, &moved, &mut out);
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().ok()?;
+        let ok = pool.install(|| sp.moved_pairs(&tree, &moved, threads, &mut out));
         assert_eq!(out.first(), Some(&7), "the sweep keeps what `out` held");
         out.remove(0);
         out.sort_unstable();
-        ok.then_some((out, sp.most_bands))
+        ok.then_some((out, sp.most_bands, sp.shared_sweeps > 0))
     }
 
     /// The sweep finds exactly the pairs a test of every pair finds: random boxes of
@@ -439,11 +544,12 @@ mod tests {
     /// checked at equality), with and without moved marks, spread wide in x or in y (so
     /// both sweep axes are taken) about the origin (negative bounds too), over areas many
     /// boxes high across the sweep (so pairs of boxes that share several bands are kept
-    /// once; every seventh box is long, across up to a dozen bands).
+    /// once; every seventh box is long, across up to a dozen bands); on one thread and
+    /// shared between three (runs of whole bands).
     #[test]
     fn sweep_finds_exactly_the_overlapping_pairs() {
         let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
-        let mut most_bands = 0;
+        let (mut most_bands, mut shared_cases) = (0, 0);
         for case in 0..40 {
             let n = 5 + case * 7;
             let (wide_x, wide_y) = [(30.0, 5.0), (5.0, 30.0), (40.0, 25.0), (15.0, 60.0), (80.0, 70.0)][case % 5];
@@ -475,8 +581,13 @@ mod tests {
             let (got, bands) = swept(&boxes).unwrap_or_default();
             assert_eq!(got, want, "case {case}");
             most_bands = most_bands.max(bands);
+            // Shared between three threads, by runs of bands: the same pairs.
+            let (got, _, shared) = swept_on(&boxes, 3).unwrap_or_default();
+            assert_eq!(got, want, "case {case} on three threads");
+            shared_cases += usize::from(shared);
         }
         assert!(most_bands >= 8, "some cases are cut into bands: at most {most_bands}");
+        assert!(shared_cases >= 20, "{shared_cases} of 40 cases shared their sweep");
     }
 
     /// Boxes all on one spot, or points (no extent: the bands' height is zero, and their
@@ -519,7 +630,7 @@ mod tests {
             ..SweepPrune::default()
         };
         let mut out = Vec::new();
-        assert!(!sp.moved_pairs(&tree, &[true, true], &mut out), "backing off");
+        assert!(!sp.moved_pairs(&tree, &[true, true], 1, &mut out), "backing off");
         assert_eq!(sp.back_off, BACK_OFF_SWEEPS - 1);
     }
 

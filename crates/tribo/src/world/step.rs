@@ -62,7 +62,7 @@ impl World {
         // (No refit is pending here, unless a step was cut short: see finalize below.)
         self.broad_phase.refit();
         self.reorder_contacts();
-        self.update_pairs();
+        self.update_pairs(parallel);
         self.profile.pairs = lap.lap();
         self.prepare_bodies(parallel);
         let bodies_ms = lap.lap();
@@ -105,7 +105,7 @@ impl World {
 
     /// Broad phase: query the trees with every moved proxy and create contacts for new
     /// pairs, in sorted pair order (deterministic).
-    fn update_pairs(&mut self) {
+    fn update_pairs(&mut self, parallel: bool) {
         let mut moved = core::mem::take(&mut self.broad_phase.moved);
         moved.sort_unstable();
         moved.dedup();
@@ -126,11 +126,10 @@ impl World {
         let walk = walk && !self.broad_phase.no_walk;
         let mut new_pairs: Vec<u64> = Vec::new();
         if walk {
-            self.moving_tree_pairs(&moved, &mut new_pairs);
+            self.moving_tree_pairs(&moved, parallel, &mut new_pairs);
         }
         // (With the moving tree's pairs found, only moved static shapes query it: no copy.)
         let use_flat = self.broad_phase.prepare_queries(moved.len(), [false, walk]);
-        let mut hits: Vec<u32> = Vec::new();
         // With the moving tree's pairs found (swept or walked), the moved shapes only have
         // the static tree left to query.
         let queries: &[u32] = if walk && self.broad_phase.trees[STATIC_TREE as usize].proxy_count() == 0 {
@@ -138,6 +137,39 @@ impl World {
         } else {
             &moved
         };
+        // On threads, in chunks of moved shapes, each chunk's pairs in a list of its own
+        // (read-only queries: sorted below, the pairs are the same whatever the split).
+        if parallel && queries.len() >= 2 * PAIR_CHUNK {
+            let this = &*self;
+            let chunks: Vec<&[u32]> = queries.chunks(PAIR_CHUNK).collect();
+            let mut found: Vec<Vec<u64>> = vec![Vec::new(); chunks.len()];
+            claim_each(true, chunks.into_iter().zip(found.iter_mut()), |(chunk, out)| {
+                this.query_pairs(chunk, walk, use_flat, out);
+            });
+            new_pairs.extend(found.into_iter().flatten());
+        } else {
+            self.query_pairs(queries, walk, use_flat, &mut new_pairs);
+        }
+        for &si in &moved {
+            if let Some(s) = self.shapes.at_mut(si) {
+                s.moved = false;
+            }
+        }
+        moved.clear();
+        self.broad_phase.moved = moved;
+        new_pairs.sort_unstable();
+        new_pairs.dedup();
+        for key in new_pairs {
+            self.create_contact((key >> 32) as u32, key as u32);
+        }
+    }
+
+    /// The new pairs of the moved shapes of `queries` with the trees' other shapes, into
+    /// `out` (see [`World::update_pairs`]): each queries the static tree, and the moving
+    /// one too unless its pairs were found at once (`walk`); `use_flat`: which trees'
+    /// [`FlatTree`] copies are current. Reads only.
+    fn query_pairs(&self, queries: &[u32], walk: bool, use_flat: [bool; 2], out: &mut Vec<u64>) {
+        let mut hits: Vec<u32> = Vec::new();
         for (j, &si) in queries.iter().enumerate() {
             // The moved shapes' records, their bodies and the bodies' key lists are asked
             // for a few shapes ahead (each needs the one before it: a chain of misses).
@@ -178,21 +210,9 @@ impl World {
                 let Some(o) = self.shapes.at(other) else { continue };
                 // When both moved, the lower index reports the pair.
                 if !(o.moved && other < si) && self.may_pair(s, body, o) {
-                    new_pairs.push(pair_key(si, other));
+                    out.push(pair_key(si, other));
                 }
             }
-        }
-        for &si in &moved {
-            if let Some(s) = self.shapes.at_mut(si) {
-                s.moved = false;
-            }
-        }
-        moved.clear();
-        self.broad_phase.moved = moved;
-        new_pairs.sort_unstable();
-        new_pairs.dedup();
-        for key in new_pairs {
-            self.create_contact((key >> 32) as u32, key as u32);
         }
     }
 
@@ -204,7 +224,7 @@ impl World {
     /// axes so that the sweep would test too many, from one walk of the tree's
     /// [`FlatTree`] copy against itself; the same pairs either way. A pair with a contact
     /// is found in the pair table without reading either shape's record.
-    fn moving_tree_pairs(&mut self, moved: &[u32], new_pairs: &mut Vec<u64>) {
+    fn moving_tree_pairs(&mut self, moved: &[u32], parallel: bool, new_pairs: &mut Vec<u64>) {
         let mut mark = core::mem::take(&mut self.broad_phase.moved_mark);
         mark.clear();
         mark.resize(self.shapes.capacity(), false);
@@ -221,7 +241,8 @@ impl World {
         let try_sweep = !bp.no_sweep;
         #[cfg(not(test))]
         let try_sweep = true;
-        let swept = try_sweep && bp.sweep.moved_pairs(&bp.trees[moving], &mark, &mut keys);
+        let threads = if parallel { rayon::current_num_threads() } else { 1 };
+        let swept = try_sweep && bp.sweep.moved_pairs(&bp.trees[moving], &mark, threads, &mut keys);
         if !swept {
             keys.clear();
             bp.walks += 1;
@@ -237,9 +258,39 @@ impl World {
         // overlap: inside the walk, among its branches, each waited alone (5 % of smash's
         // step at one instruction; pairs stage 1.54 → 1.44 ms in smash, 2.26 → 2.14 in
         // rain, 0.504 → 0.490 in tumbler).
+        // On threads, in chunks of keys, each chunk's new pairs in a list of its own
+        // (lookups only; sorted by the caller, the pairs are the same whatever the split).
+        if parallel && keys.len() >= 2 * KEY_CHUNK {
+            let this = &*self;
+            let chunks: Vec<&mut [u64]> = keys.chunks_mut(KEY_CHUNK).collect();
+            let mut found: Vec<Vec<u64>> = vec![Vec::new(); chunks.len()];
+            claim_each(true, chunks.into_iter().zip(found.iter_mut()), |(chunk, out)| {
+                this.new_pairs_of(chunk, out);
+            });
+            new_pairs.extend(found.into_iter().flatten());
+        } else {
+            self.new_pairs_of(&mut keys, new_pairs);
+        }
+        self.broad_phase.scratch_keys = keys;
+        self.broad_phase.moved_mark = mark;
+    }
+
+    /// The pairs of `keys` (overlapping boxes) that have no contact and may pair, into
+    /// `out`; `keys` is scratch (reordered, its tail overwritten).
+    fn new_pairs_of(&self, keys: &mut [u64], out: &mut Vec<u64>) {
         let pairs = &self.broad_phase.pairs;
-        keys.retain(|key| !pairs.contains_key(key));
-        for &key in &keys {
+        // The pairs without a contact moved to the front, in order (a `retain` in place).
+        let mut kept = 0;
+        for k in 0..keys.len() {
+            let Some(&key) = keys.get(k) else { break };
+            if !pairs.contains_key(&key) {
+                if let Some(slot) = keys.get_mut(kept) {
+                    *slot = key;
+                }
+                kept += 1;
+            }
+        }
+        for &key in keys.get(..kept).unwrap_or(&[]) {
             let (sa, sb) = ((key >> 32) as u32, key as u32);
             let (Some(s), Some(o)) = (self.shapes.at(sa), self.shapes.at(sb)) else {
                 continue;
@@ -249,11 +300,9 @@ impl World {
                 .at(s.body.index)
                 .is_some_and(|body| self.may_pair(s, body, o))
             {
-                new_pairs.push(key);
+                out.push(key);
             }
         }
-        self.broad_phase.scratch_keys = keys;
-        self.broad_phase.moved_mark = mark;
     }
 
     /// Whether shapes `s` (of `body`) and `o`, whose boxes overlap and which have no
@@ -1516,6 +1565,12 @@ const WALK_SHARE: usize = 2;
 
 /// How many moved shapes ahead [`World::update_pairs`] asks for their records.
 const PAIR_PREFETCH: usize = 8;
+
+/// Moved shapes per parallel chunk of the broad phase's queries.
+const PAIR_CHUNK: usize = 256;
+
+/// Pair keys per parallel chunk of the broad phase's lookups of found pairs.
+const KEY_CHUNK: usize = 2048;
 
 /// Writes a body's solver state `s` (after a step of `dt` [s]) into its record: velocity,
 /// pose from the step's motion, and sleep timer. Returns false, leaving the body at its
