@@ -474,8 +474,10 @@ fn bad_joint_input_is_rejected_and_changes_nothing() {
 
 #[test]
 fn joints_give_bit_identical_results_on_any_thread_count() {
-    // Joints are solved on one thread before the coloured contacts of each pass: the
-    // results must not depend on the worker count.
+    // Joints are solved before the coloured contacts of each pass, block colour by block
+    // colour (a chain this short is one block; the blocks of large sets are shared between
+    // threads: the world's hanging-grid test and tribo-scenes' joint_grid): the results
+    // must not depend on the worker count.
     let run = |workers: u32| {
         let (mut w, _, links) = chain(30, workers, false);
         for _ in 0..120 {

@@ -142,9 +142,9 @@ impl SweepPrune {
     /// [`BACK_OFF_SWEEPS`] calls); the caller then walks the tree.
     /// With `threads` > 1 (inside the pool that has them), the sweep of step 3 is shared:
     /// the bands cut into one run of whole bands per thread, of about as many entries
-    /// each, each run swept with its share of the test budget into a list of its own. The
-    /// pairs are the same; only whether the sweep gives up may differ (a run over its
-    /// share), and then the caller's walk finds them.
+    /// each, each run swept into a list of its own; it gives up when the runs' tests add
+    /// up to more than the budget, which is when one thread's sweep gives up (its count
+    /// only grows): the same pairs, the same give-up and back-off, for any thread count.
     #[inline(never)]
     pub fn moved_pairs(&mut self, tree: &DynamicTree, moved: &[bool], threads: usize, out: &mut Vec<u64>) -> bool {
         if self.back_off > 0 {
@@ -287,7 +287,7 @@ impl SweepPrune {
         let start = out.len();
         let budget = MAX_TESTS_PER_BOX * n;
         let runs = self.runs(threads, entries);
-        let swept = if runs.len() < 2 {
+        let tests = if runs.len() < 2 {
             sweep_sorted(
                 [&self.lo, &self.hi, &self.cross_lo, &self.cross_hi],
                 &self.data,
@@ -299,30 +299,29 @@ impl SweepPrune {
             )
         } else {
             self.shared_sweeps += 1;
-            let mut found: Vec<(Vec<u64>, bool)> = vec![(Vec::new(), true); runs.len()];
+            let mut found: Vec<(Vec<u64>, usize)> = vec![(Vec::new(), 0); runs.len()];
             let this = &*self;
-            crate::solver::claim_each(true, runs.iter().zip(found.iter_mut()), |(run, (pairs, ok))| {
+            crate::solver::claim_each(true, runs.iter().zip(found.iter_mut()), |(run, (pairs, tests))| {
                 fn part<'a, T>(v: &'a [T], run: &SweepRun) -> &'a [T] {
                     v.get(run.start..run.end).unwrap_or(&[])
                 }
-                // (Its share of the budget, by its share of the entries, rounded up.)
-                let share = (budget * run.entries).div_ceil(entries.max(1));
-                *ok = sweep_sorted(
+                *tests = sweep_sorted(
                     [&this.lo, &this.hi, &this.cross_lo, &this.cross_hi].map(|v| part(v, run)),
                     part(&this.data, run),
                     part(&this.moved, run),
                     [part(&this.band, run), part(&this.first, run)],
-                    share,
+                    budget,
                     &mut Vec::new(),
                     pairs,
                 );
             });
-            let ok = found.iter().all(|f| f.1);
+            let tests = found.iter().fold(0usize, |sum, f| sum.saturating_add(f.1));
             for (pairs, _) in found {
                 out.extend(pairs);
             }
-            ok
+            tests
         };
+        let swept = tests <= budget;
         if !swept {
             out.truncate(start);
             self.back_off = BACK_OFF_SWEEPS;
@@ -332,12 +331,11 @@ impl SweepPrune {
     }
 }
 
-/// A run of whole bands of the sweep arrays (their places, padding included) and how
-/// many entries it holds ([`SweepPrune::runs`]).
+/// A run of whole bands of the sweep arrays: their places, padding included
+/// ([`SweepPrune::runs`]).
 struct SweepRun {
     start: usize,
     end: usize,
-    entries: usize,
 }
 
 impl SweepPrune {
@@ -373,7 +371,6 @@ impl SweepPrune {
             runs.push(SweepRun {
                 start: place(from),
                 end: place(to),
-                entries: count(to) - count(from),
             });
             from = to;
             if from >= bands {
@@ -391,8 +388,8 @@ impl SweepPrune {
 /// ends after box i starts (it starts no earlier and a box ends no earlier than it
 /// starts), so only the cross axis is left to test, four boxes in one comparison; most
 /// candidates miss (tumbler: two in three), so the hits are taken from the comparison's
-/// bits. False (with pairs
-/// pushed) past `budget` tests. A function of its own, on slices: inlined into the
+/// bits. Returns the candidates tested, stopping (with pairs pushed) once they pass
+/// `budget`. A function of its own, on slices: inlined into the
 /// step, its loop kept its values on the stack (the sweep took 0.24 ms of tumbler's step).
 #[inline(never)]
 fn sweep_sorted(
@@ -403,7 +400,7 @@ fn sweep_sorted(
     budget: usize,
     hits: &mut Vec<u32>,
     out: &mut Vec<u64>,
-) -> bool {
+) -> usize {
     // The arrays cut to one length, which one test per chunk then covers.
     let len = bounds.iter().map(|b| b.len()).fold(
         data.len()
@@ -476,10 +473,10 @@ fn sweep_sorted(
             }
         }
         if tests > budget {
-            return false;
+            return tests;
         }
     }
-    true
+    tests
 }
 
 #[cfg(test)]

@@ -26,11 +26,13 @@
 //! This is the structure of Box2D v3's revolute joint (`revolute_joint.c`: spring, motor,
 //! limits, point; soft position correction at the joint's own frequency, 60 Hz and ζ 2 by
 //! default, clamped to a quarter of the substep rate), written anew from the equations
-//! above. Joints are solved one at a time before the contacts of each pass (Box2D solves
-//! its overflow constraints first too): they are few next to contacts in most scenes, and
-//! the order keeps results independent of the thread count. The passes take them in a
-//! colour order made inside small windows of the slot order ([`JointSolver::order_joints`]),
-//! so consecutive joints seldom wait for each other's velocities.
+//! above. Joints are solved before the contacts of each pass (Box2D solves its overflow
+//! constraints first too), in blocks of consecutive joints coloured so that the blocks of
+//! one colour write no body in common: colour after colour, each colour's blocks shared
+//! between threads, in an order that does not depend on the thread count. Inside a block
+//! the passes take them in a colour order made inside small windows of the slot order
+//! ([`JointSolver::order_joints`]), so consecutive joints seldom wait for each other's
+//! velocities.
 
 use super::{Softness, StateCell, StepContext};
 use crate::dynamics::joint::{JointImpulses, JointRecord};
@@ -327,7 +329,7 @@ const _: () = assert!(ORDER_WINDOW <= 32); // colours are bits of a u32
 
 /// Joints per block of the threaded passes (a multiple of [`ORDER_WINDOW`], so a block
 /// holds whole windows of the solve order): consecutive joints in slot order, coloured so
-/// that the blocks of one colour write no body in common ([`JointSolver::order_joints`]).
+/// that the blocks of one colour write no body in common ([`JointSolver::colour_blocks`]).
 const JOINT_BLOCK: usize = 256;
 const _: () = assert!(JOINT_BLOCK % ORDER_WINDOW == 0);
 
@@ -466,8 +468,9 @@ impl JointSolver {
     /// and with threads share out each colour's blocks: blocks of one colour write no body
     /// in common (a joint writes both its bodies unless one is static, kinematic or
     /// asleep, which no joint writes), so they may run in any order and on any thread with
-    /// the same result. Below two blocks (255 joints or fewer) there is one colour and the
-    /// order is the windows' alone. Box2D v3 colours its joints one by one with its
+    /// the same result. Up to 256 joints (one block) the order is the windows' alone; so
+    /// it is when every block takes colour 0 (blocks that share no body: separate chains
+    /// or ragdolls), whose blocks are still shared between threads. Box2D v3 colours its joints one by one with its
     /// contacts; whole blocks keep the windows' order inside, whose joints are read within
     /// a few kilobytes of each other (see [`ORDER_WINDOW`]).
     fn colour_blocks(&mut self) {
@@ -499,18 +502,44 @@ impl JointSolver {
         let top = colours.iter().copied().max().map_or(0, |c| c as usize + 1);
         for c in 0..top {
             let at = self.block_order.len();
-            self.block_order
-                .extend((0..colours.len() as u32).filter(|&b| colours[b as usize] as usize == c));
+            self.block_order.extend(
+                colours
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &colour)| colour as usize == c)
+                    .map(|(b, _)| b as u32),
+            );
             if self.block_order.len() > at {
                 self.colour_ends.push(self.block_order.len());
             }
         }
+        #[cfg(debug_assertions)]
+        self.check_block_colours(&colours);
         // (The serial colour, if used, is the last one; its blocks are marked by it.)
         self.serial_from = if colours.iter().any(|&c| c as usize == SERIAL_BLOCKS) {
             self.colour_ends.len() - 1
         } else {
             usize::MAX
         };
+    }
+
+    /// Debug builds: no two blocks of one shared colour write the same state (what makes
+    /// sharing a colour's blocks between threads race-free).
+    #[cfg(debug_assertions)]
+    fn check_block_colours(&self, colours: &[u8]) {
+        let mut writer = std::collections::HashMap::new();
+        for (b, block) in self.order_bodies.chunks(JOINT_BLOCK).enumerate() {
+            let Some(&colour) = colours.get(b).filter(|&&c| (c as usize) < SERIAL_BLOCKS) else {
+                continue;
+            };
+            for &i in block.iter().flatten().filter(|&&i| i != 0) {
+                let first = *writer.entry((colour, i)).or_insert(b);
+                debug_assert_eq!(
+                    first, b,
+                    "joint blocks {first} and {b} of colour {colour} both write state {i}"
+                );
+            }
+        }
     }
 
     /// Whether the passes would give each of `threads` threads at least
@@ -545,8 +574,8 @@ impl JointSolver {
                 }
             }
         };
-        if self.colour_ends.len() <= 1 || S::as_shared(states).is_none() {
-            // One colour, or one thread: the blocks in the same order, here.
+        if self.block_order.len() < 2 || S::as_shared(states).is_none() {
+            // One block, or one thread: the blocks in the same order, here.
             let mut start = 0;
             for &end in &self.colour_ends {
                 for &b in self.block_order.get(start..end).unwrap_or(&[]) {

@@ -17,7 +17,8 @@
 //! 4. store impulses and friction states back into the contacts
 //!
 //! Constraints join the solver through [`ConstraintSet`]: [`StepConstraints`] holds the
-//! step's joints ([`joint_solver`], solved one at a time first in each pass) and contacts
+//! step's joints ([`joint_solver`], solved first in each pass, block colour by block
+//! colour) and contacts
 //! (`contact_set`, coloured and wide, in the build of the wide solver the world runs:
 //! [`Contacts`]).
 
@@ -69,6 +70,10 @@ pub(crate) struct BodyState {
 ///   `ContactSolver::build`), so while a colour runs each dynamic body's state is touched
 ///   by at most one thread; the static body (index 0) and kinematic bodies are only read
 ///   by constraints (their lanes' write flags are off);
+/// - the joint passes run block colour by block colour, and the blocks of one colour
+///   write no body in common (`JointSolver::colour_blocks`; checked by a `debug_assert`);
+///   the blocks that found no free colour run one after another on one thread, after the
+///   others;
 /// - body integration splits the bodies into disjoint ranges, one per task or block;
 /// - between colours and stages the threads meet at the end of a rayon scope
 ///   ([`claim_each`]) or wait until every block of the pass is done ([`TeamProgress`]),
@@ -908,8 +913,8 @@ impl<K: ConstraintSet> ConstraintSet for StepConstraints<'_, K> {
         states: &[SharedState],
         times: &mut [f32; 5],
     ) -> bool {
-        // The team solves colours only; joints run on one thread before each pass's
-        // colours, which the per-colour path does.
+        // The team solves contact colours only; joints run before each pass's colours
+        // (their block colours shared between threads), which the per-colour path does.
         self.joints.constraints.is_empty() && self.contacts.substeps_team(ctx, sims, states, times)
     }
 }

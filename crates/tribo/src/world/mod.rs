@@ -1699,8 +1699,9 @@ mod tests {
         );
     }
 
-    /// A hanging grid of 40 × 40 disks on 3 120 revolute joints (its top row pinned, as in
-    /// Box2D's joint_grid) shares its joint passes between two threads, block colour by
+    /// A hanging grid of 40 columns of 39 disks on 3 081 revolute joints (each column hung
+    /// from the ground, as joint_grid's top row is pinned) shares its joint passes between
+    /// two threads, block colour by
     /// block colour, and ends to the bit where a one-thread world puts it. The joints hold:
     /// each pivot's two anchors stay within 1 cm (the soft joints give millimetres under a
     /// 39-disk column), and the grid hangs from its pins (its lowest disk 39 m down, the
