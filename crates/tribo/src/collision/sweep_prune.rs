@@ -299,13 +299,12 @@ impl SweepPrune {
             )
         } else {
             self.shared_sweeps += 1;
-            let mut found: Vec<(Vec<u64>, usize)> = vec![(Vec::new(), 0); runs.len()];
             let this = &*self;
-            crate::solver::claim_each(true, runs.iter().zip(found.iter_mut()), |(run, (pairs, tests))| {
+            let tests = crate::solver::claim_into(&runs, out, |run, pairs| {
                 fn part<'a, T>(v: &'a [T], run: &SweepRun) -> &'a [T] {
                     v.get(run.start..run.end).unwrap_or(&[])
                 }
-                *tests = sweep_sorted(
+                sweep_sorted(
                     [&this.lo, &this.hi, &this.cross_lo, &this.cross_hi].map(|v| part(v, run)),
                     part(&this.data, run),
                     part(&this.moved, run),
@@ -313,13 +312,9 @@ impl SweepPrune {
                     budget,
                     &mut Vec::new(),
                     pairs,
-                );
+                )
             });
-            let tests = found.iter().fold(0usize, |sum, f| sum.saturating_add(f.1));
-            for (pairs, _) in found {
-                out.extend(pairs);
-            }
-            tests
+            tests.iter().fold(0usize, |sum, &t| sum.saturating_add(t))
         };
         let swept = tests <= budget;
         if !swept {

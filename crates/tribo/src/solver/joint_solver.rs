@@ -470,9 +470,9 @@ impl JointSolver {
     /// asleep, which no joint writes), so they may run in any order and on any thread with
     /// the same result. Up to 256 joints (one block) the order is the windows' alone; so
     /// it is when every block takes colour 0 (blocks that share no body: separate chains
-    /// or ragdolls), whose blocks are still shared between threads. Box2D v3 colours its joints one by one with its
-    /// contacts; whole blocks keep the windows' order inside, whose joints are read within
-    /// a few kilobytes of each other (see [`ORDER_WINDOW`]).
+    /// or ragdolls), whose blocks are still shared between threads. Box2D v3 colours its
+    /// joints one by one with its contacts; whole blocks keep the windows' order inside,
+    /// whose joints are read within a few kilobytes of each other (see [`ORDER_WINDOW`]).
     fn colour_blocks(&mut self) {
         let used = &mut self.used;
         let colours: Vec<u8> = self
@@ -553,8 +553,9 @@ impl JointSolver {
     /// Runs `pass` on every constraint, block colour after block colour (see
     /// [`JointSolver::colour_blocks`]); within a block in slot order (the warm start) or in
     /// the solve order. (A pass, not a closure: called through a closure, each joint's
-    /// rows were a call of their own.) With shared states (the threaded step), each colour's blocks are shared
-    /// between the pool's threads, the serial colour's run on this thread.
+    /// rows were a call of their own.) With shared states (the threaded step), each
+    /// colour's blocks are shared between the pool's threads, the serial colour's run on
+    /// this thread.
     fn pass<S: StateCell>(&mut self, states: &[S], ctx: &StepContext, pass: JointPass) {
         let order = &self.order;
         let run = |b: usize, block: &mut [JointConstraint], states: &[S]| {
@@ -574,23 +575,15 @@ impl JointSolver {
                 }
             }
         };
-        if self.block_order.len() < 2 || S::as_shared(states).is_none() {
-            // One block, or one thread: the blocks in the same order, here.
-            let mut start = 0;
-            for &end in &self.colour_ends {
-                for &b in self.block_order.get(start..end).unwrap_or(&[]) {
-                    let b = b as usize;
-                    let first = b * JOINT_BLOCK;
-                    let last = (first + JOINT_BLOCK).min(self.constraints.len());
-                    if let Some(block) = self.constraints.get_mut(first..last) {
-                        run(b, block, states);
-                    }
-                }
-                start = end;
+        // No joints, or one block: here, without the lists below.
+        if self.block_order.len() < 2 {
+            if let Some(&b) = self.block_order.first() {
+                run(b as usize, &mut self.constraints, states);
             }
             return;
         }
-        self.shared_passes += 1;
+        let shared = S::as_shared(states).is_some();
+        self.shared_passes += u64::from(shared);
         let mut blocks: Vec<Option<&mut [JointConstraint]>> =
             self.constraints.chunks_mut(JOINT_BLOCK).map(Some).collect();
         let mut start = 0;
@@ -603,12 +596,13 @@ impl JointSolver {
                 .filter_map(|&b| blocks.get_mut(b as usize)?.take().map(|block| (b as usize, block)))
                 .collect();
             start = end;
-            if c >= self.serial_from {
+            if shared && c < self.serial_from {
+                S::for_each_mut(states, &mut items, 1, |_, (b, block), states| run(*b, block, states));
+            } else {
+                // One thread, or the serial colour: its blocks in order, here.
                 for (b, block) in items {
                     run(b, block, states);
                 }
-            } else {
-                S::for_each_mut(states, &mut items, 1, |_, (b, block), states| run(*b, block, states));
             }
         }
     }

@@ -663,6 +663,28 @@ pub(crate) fn claim_each<T: Send>(parallel: bool, items: impl IntoIterator<Item 
     claim_shares(threads, slots, &ends, f);
 }
 
+/// [`claim_each`] on the pool's threads over `chunks`, each writing what it finds into a
+/// list of its own, appended to `out` in chunk order (the same list whatever the thread
+/// count, as one thread going through the chunks in order would make it); returns what
+/// `f` returned for each chunk, in chunk order.
+pub(crate) fn claim_into<C: Send, U: Send, R: Send + Default>(
+    chunks: impl IntoIterator<Item = C>,
+    out: &mut Vec<U>,
+    f: impl Fn(C, &mut Vec<U>) -> R + Sync,
+) -> Vec<R> {
+    let chunks: Vec<C> = chunks.into_iter().collect();
+    let mut found: Vec<(Vec<U>, R)> = chunks.iter().map(|_| (Vec::new(), R::default())).collect();
+    claim_each(true, chunks.into_iter().zip(found.iter_mut()), |(chunk, (list, r))| {
+        *r = f(chunk, list);
+    });
+    let mut results = Vec::with_capacity(found.len());
+    for (list, r) in found {
+        out.extend(list);
+        results.push(r);
+    }
+    results
+}
+
 /// The items of a [`claim_each`] in their slots: each sits in its slot until one thread
 /// takes it (each slot is locked once).
 fn claim_slots<T>(items: impl IntoIterator<Item = T>) -> Vec<std::sync::Mutex<Option<T>>> {

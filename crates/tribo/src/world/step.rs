@@ -20,8 +20,8 @@ use crate::math::{Rot, Vec2};
 use crate::solver::candidates::{Candidate, Candidates, ColourKey};
 use crate::solver::WideContacts;
 use crate::solver::{
-    claim_each, for_each_chunk_mut4, for_each_mut, loads, solve_step, BodySim, BodyState, SharedState, SolverBody,
-    StepConstraints, StepContext,
+    claim_each, claim_into, for_each_chunk_mut4, for_each_mut, loads, solve_step, BodySim, BodyState, SharedState,
+    SolverBody, StepConstraints, StepContext,
 };
 use crate::world::Arena;
 use crate::world::{box_velocity, next_box};
@@ -141,12 +141,9 @@ impl World {
         // (read-only queries: sorted below, the pairs are the same whatever the split).
         if parallel && queries.len() >= 2 * PAIR_CHUNK {
             let this = &*self;
-            let chunks: Vec<&[u32]> = queries.chunks(PAIR_CHUNK).collect();
-            let mut found: Vec<Vec<u64>> = vec![Vec::new(); chunks.len()];
-            claim_each(true, chunks.into_iter().zip(found.iter_mut()), |(chunk, out)| {
-                this.query_pairs(chunk, walk, use_flat, out);
+            claim_into(queries.chunks(PAIR_CHUNK), &mut new_pairs, |chunk, out| {
+                this.query_pairs(chunk, walk, use_flat, out)
             });
-            new_pairs.extend(found.into_iter().flatten());
         } else {
             self.query_pairs(queries, walk, use_flat, &mut new_pairs);
         }
@@ -262,12 +259,9 @@ impl World {
         // (lookups only; sorted by the caller, the pairs are the same whatever the split).
         if parallel && keys.len() >= 2 * KEY_CHUNK {
             let this = &*self;
-            let chunks: Vec<&mut [u64]> = keys.chunks_mut(KEY_CHUNK).collect();
-            let mut found: Vec<Vec<u64>> = vec![Vec::new(); chunks.len()];
-            claim_each(true, chunks.into_iter().zip(found.iter_mut()), |(chunk, out)| {
-                this.new_pairs_of(chunk, out);
+            claim_into(keys.chunks_mut(KEY_CHUNK), new_pairs, |chunk, out| {
+                this.new_pairs_of(chunk, out)
             });
-            new_pairs.extend(found.into_iter().flatten());
         } else {
             self.new_pairs_of(&mut keys, new_pairs);
         }
