@@ -169,11 +169,15 @@ pub(crate) enum Memo {
     Basis(RecycleBasis),
     /// A touching pair's poses when its manifold was computed, from which
     /// [`Contact::recycle`] makes the [`Memo::Basis`] the first time it tries to reuse the
-    /// manifold. A pair too fast to be recycled (more than [`RECYCLE_STEP`] a step) is
-    /// collided again without trying, so it never needs one: in smash, junkyard and the
-    /// tumbler most full collisions are of such pairs, and making the basis each time was a
-    /// tenth of a full collision's instructions.
-    Posed { xf_a: Transform, xf_b: Transform },
+    /// manifold, and the manifold's step allowance (see [`RecycleBasis::allowance`]). A
+    /// pair moving faster than that is collided again without trying, so it never needs a
+    /// basis: in smash, junkyard and the tumbler many full collisions are of such pairs,
+    /// and making the basis each time was a tenth of a full collision's instructions.
+    Posed {
+        xf_a: Transform,
+        xf_b: Transform,
+        allowance: f32,
+    },
     /// A pair found apart: a lower bound [m] (> 0) on its surfaces' distance at the poses
     /// `poses` ([`Contact::still_apart`]).
     Far { bound: f32, poses: FarPoses },
@@ -217,13 +221,22 @@ pub(crate) struct RecycleBasis {
     pub a_in_b: [Vec2; MAX_MANIFOLD_POINTS],
     /// Rotation from A's frame to B's frame when the basis was made.
     pub rel_q: Rot,
+    /// The largest relative motion in one step [m] (the narrow phase's `dt · rel`) for
+    /// which the manifold may be reused: the margin it was computed with less the linear
+    /// slop ([`RECYCLE_STEP`] for a pair collided at the speculative distance; more for a
+    /// fast pair, whose margin grew with its motion). See [`RECYCLE_DISTANCE`].
+    pub allowance: f32,
 }
 
 impl RecycleBasis {
     /// The basis of `manifold`, computed with the bodies at `xf_a` and `xf_b`: each point's
-    /// surface points (half the separation either side along the normal) in both frames.
-    fn of(manifold: &Manifold, xf_a: Transform, xf_b: Transform) -> RecycleBasis {
-        let mut basis = RecycleBasis::default();
+    /// surface points (half the separation either side along the normal) in both frames;
+    /// `allowance` [m]: see [`RecycleBasis::allowance`].
+    fn of(manifold: &Manifold, xf_a: Transform, xf_b: Transform, allowance: f32) -> RecycleBasis {
+        let mut basis = RecycleBasis {
+            allowance,
+            ..RecycleBasis::default()
+        };
         let n = manifold.normal;
         for i in 0..manifold.count.min(MAX_MANIFOLD_POINTS) {
             let mp = &manifold.points[i];
@@ -252,11 +265,13 @@ impl RecycleBasis {
 /// polygon contacts) keeps its exact separation, the face being flat; a point clipped at a
 /// face's end may ride up to 1.5 cm past it; a tipping box is caught by its turn; pairs
 /// with a rounded shape, whose contact points roll, keep a tighter limit
-/// ([`ROUND_RECYCLE_DISTANCE`]). A feature the manifold lacks was further than
-/// the speculative distance when the manifold was made, has moved by at most this distance
-/// since, and closes by at most [`RECYCLE_STEP`] in the step, so it can overlap by at most
-/// 1.5 cm + 1.5 cm − 2 cm = 1 cm: the bound of the earlier limits (5 mm of point motion and
-/// 5 mm of turn, tested apart, and 2 cm a step). Box2D v3 reuses manifolds up to 10 × linear
+/// ([`ROUND_RECYCLE_DISTANCE`]). A feature the manifold lacks was further than the margin
+/// m the manifold was computed with (the speculative distance, grown by the pair's motion
+/// then), has moved by at most this distance since, and closes by at most the pair's
+/// `dt · rel` in the step, which recycling allows up to m less the linear slop
+/// ([`RecycleBasis::allowance`]; [`RECYCLE_STEP`] for m = the speculative distance), so it
+/// can overlap by at most 1.5 cm + (m − 0.5 cm) − m = 1 cm: the bound of the earlier limits
+/// (5 mm of point motion and 5 mm of turn, tested apart, and 2 cm a step). Box2D v3 reuses manifolds up to 10 × linear
 /// slop (5 cm, also motion plus turn times extent), keeping the anchors as they were.
 /// History: 1 mm (resting pairs only) until 2026-12; then 5 mm, which cut the manifolds
 /// computed per step by 42 % in Box2D's washer, 36 % in its tumbler, 34 % in junkyard and
@@ -276,9 +291,13 @@ pub(crate) const RECYCLE_DISTANCE: f32 = 3.0 * LINEAR_SLOP;
 /// from 0.06 % to 0.58 % (of a ±2 % tolerance); this keeps it at its earlier value.
 pub(crate) const ROUND_RECYCLE_DISTANCE: f32 = LINEAR_SLOP;
 
-/// Largest relative motion per step [m] of a pair whose manifold is recycled (the narrow
-/// phase's guard, `dt · rel`): the speculative distance less the linear slop (1.5 cm);
-/// faster pairs are collided again. See [`RECYCLE_DISTANCE`] for the bound it keeps.
+/// Largest relative motion per step [m] (the narrow phase's `dt · rel`) of a pair whose
+/// manifold, computed at the speculative distance, is recycled: the speculative distance
+/// less the linear slop (1.5 cm); faster pairs are collided again. A manifold computed with
+/// a margin grown by the pair's motion allows that growth more
+/// ([`RecycleBasis::allowance`]; Box2D's fast bodies bypass recycling instead: tumbler,
+/// 1 283 of 9 237 pairs a step were too fast for 1.5 cm, 453 of them recyclable by their
+/// own margin). See [`RECYCLE_DISTANCE`] for the bound it keeps.
 pub(crate) const RECYCLE_STEP: f32 = SPECULATIVE_DISTANCE - LINEAR_SLOP;
 
 impl Contact {
@@ -334,9 +353,18 @@ impl Contact {
         self.memo = Memo::Posed {
             xf_a: Transform::IDENTITY,
             xf_b: Transform::IDENTITY,
+            allowance: 0.0,
         };
-        if let Memo::Posed { xf_a: a, xf_b: b } = &mut self.memo {
+        if let Memo::Posed {
+            xf_a: a,
+            xf_b: b,
+            allowance,
+        } = &mut self.memo
+        {
             (*a, *b) = (xf_a, xf_b);
+            // The margin's growth over the speculative distance (the pair's motion then)
+            // is allowed on top of `RECYCLE_STEP`.
+            *allowance = RECYCLE_STEP + (speculative_distance - SPECULATIVE_DISTANCE);
         }
         true
     }
@@ -380,24 +408,31 @@ impl Contact {
     /// surface point on B seen from A and on A seen from B (a rolling disk moves its
     /// ground point away at once), and the relative rotation times `extent` [m], the reach
     /// of the smaller body's features from the contact (a tipping box brings other
-    /// features near): normal, points and
-    /// separations are then refreshed from the stored material points (same feature ids,
-    /// so impulses and friction states carry over unchanged). Returns false (and changes
-    /// nothing) when the contact must be collided again.
-    pub fn recycle(&mut self, xf_a: Transform, xf_b: Transform, extent: f32) -> bool {
+    /// features near), and whose largest relative motion this step, `step` [m] (`dt ·
+    /// rel`), is within the manifold's allowance ([`RecycleBasis::allowance`]): normal,
+    /// points and separations are then refreshed from the stored material points (same
+    /// feature ids, so impulses and friction states carry over unchanged). Returns false
+    /// (and changes nothing but the memo's form) when the contact must be collided again.
+    pub fn recycle(&mut self, xf_a: Transform, xf_b: Transform, extent: f32, step: f32) -> bool {
         let count = self.manifold.count;
         if count == 0 {
             return false;
         }
-        if let Memo::Posed {
-            xf_a: then_a,
-            xf_b: then_b,
-        } = self.memo
-        {
-            // The manifold is still the one computed at these poses: a recycle first makes
-            // the basis, and `update` and `clear_manifold` replace the memo with the
-            // manifold.
-            self.memo = Memo::Basis(RecycleBasis::of(&self.manifold, then_a, then_b));
+        match self.memo {
+            Memo::Posed { allowance, .. } | Memo::Basis(RecycleBasis { allowance, .. }) if step > allowance => {
+                return false
+            }
+            Memo::Posed {
+                xf_a: then_a,
+                xf_b: then_b,
+                allowance,
+            } => {
+                // The manifold is still the one computed at these poses: a recycle first
+                // makes the basis, and `update` and `clear_manifold` replace the memo with
+                // the manifold.
+                self.memo = Memo::Basis(RecycleBasis::of(&self.manifold, then_a, then_b, allowance));
+            }
+            _ => {}
         }
         let Memo::Basis(basis) = &self.memo else {
             return false;
@@ -518,7 +553,7 @@ mod tests {
         moved: Transform,
     ) -> (Contact, Contact) {
         let mut recycled = c.clone();
-        assert!(recycled.recycle(xf_g, moved, 2.0 * 0.71));
+        assert!(recycled.recycle(xf_g, moved, 2.0 * 0.71, 0.0));
         let mut fresh = c.clone();
         assert!(fresh.update(ground, xf_g, block, moved, 0.02));
         for i in 0..fresh.manifold.count {
@@ -583,7 +618,39 @@ mod tests {
         let (recycled, _) = recycled_and_fresh(&c, &ground, xf_g, &block, slid);
         assert_eq!(recycled.manifold.count, 2);
         let beyond = Transform::new(Vec2::new(0.3 + 1.2 * RECYCLE_DISTANCE, 0.499), 0.0);
-        assert!(!c.recycle(xf_g, beyond, 2.0 * 0.71));
+        assert!(!c.recycle(xf_g, beyond, 2.0 * 0.71, 0.0));
+    }
+
+    /// How fast a pair may move in the step of a recycle depends on the margin its
+    /// manifold was computed with: a feature the manifold lacks was further than that
+    /// margin m, so a step of up to m − slop (plus the 1.5 cm of recycle motion) leaves it
+    /// at most 1 cm of overlap. At the speculative distance (2 cm) the allowance is
+    /// `RECYCLE_STEP` (1.5 cm); computed with a margin of 5 cm (a pair moving 3 cm a step),
+    /// 4.5 cm. Each is refused just past its allowance and accepted just under it, with
+    /// the same (unmoved) poses, so only the step decides.
+    #[test]
+    fn a_manifold_allows_the_step_its_margin_covered() {
+        let ground = Shape::Polygon(Polygon::new_box(5.0, 0.5).unwrap());
+        let block = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
+        let xf_g = Transform::new(Vec2::new(0.0, -0.5), 0.0);
+        let xf_b = Transform::new(Vec2::new(0.3, 0.499), 0.0);
+        for (margin, allowance) in [(SPECULATIVE_DISTANCE, RECYCLE_STEP), (0.05, 0.045)] {
+            let mut c = contact();
+            assert!(c.update(&ground, xf_g, &block, xf_b, margin));
+            assert!((allowance - (margin - LINEAR_SLOP)).abs() < 1e-7);
+            assert!(
+                !c.clone().recycle(xf_g, xf_b, 2.0 * 0.71, allowance + 1e-4),
+                "margin {margin}"
+            );
+            // Refused without making the basis: the poses stay for a later try.
+            let mut refused = c.clone();
+            assert!(!refused.recycle(xf_g, xf_b, 2.0 * 0.71, allowance + 1e-4));
+            assert!(matches!(refused.memo, Memo::Posed { .. }));
+            assert!(c.recycle(xf_g, xf_b, 2.0 * 0.71, allowance - 1e-4), "margin {margin}");
+            // The basis keeps the allowance for the next steps.
+            assert!(!c.clone().recycle(xf_g, xf_b, 2.0 * 0.71, allowance + 1e-4));
+            assert!(c.recycle(xf_g, xf_b, 2.0 * 0.71, allowance - 1e-4));
+        }
     }
 
     /// A ground box (top face y = 0), a disk of radius 0.5 m and the ground's pose.
@@ -609,10 +676,10 @@ mod tests {
         assert!(c.update(&ground, xf_g, &disk, Transform::new(Vec2::new(0.0, 0.499), 0.0), 0.02));
         assert_eq!(c.manifold.count, 1);
         // A touching contact keeps its poses; its first recycle makes the basis from them.
-        let Memo::Posed { xf_a, xf_b } = c.memo else {
+        let Memo::Posed { xf_a, xf_b, allowance } = c.memo else {
             panic!("a touching contact keeps its poses")
         };
-        c.memo = Memo::Basis(RecycleBasis::of(&c.manifold, xf_a, xf_b));
+        c.memo = Memo::Basis(RecycleBasis::of(&c.manifold, xf_a, xf_b, allowance));
         let Memo::Basis(basis) = &mut c.memo else {
             panic!("a recycling basis")
         };
@@ -622,11 +689,11 @@ mod tests {
         // Lifted by 1 mm: the material points moved 1 mm < RECYCLE_DISTANCE.
         let lifted = Transform::new(Vec2::new(0.0, 0.5), 0.0);
         let mut recycled = c.clone();
-        assert!(recycled.recycle(xf_g, lifted, 2.0 * 0.5));
+        assert!(recycled.recycle(xf_g, lifted, 2.0 * 0.5, 0.0));
         assert!((recycled.manifold.points[0].separation - (c.manifold.points[0].separation + 1e-3)).abs() < 1e-6);
         // Lifted by 1.2 × RECYCLE_DISTANCE: beyond it, collided again.
         let beyond = Transform::new(Vec2::new(0.0, 0.499 + 1.2 * RECYCLE_DISTANCE), 0.0);
-        assert!(!c.clone().recycle(xf_g, beyond, 2.0 * 0.5));
+        assert!(!c.clone().recycle(xf_g, beyond, 2.0 * 0.5, 0.0));
     }
 
     /// A rolling disk's contact point is not a material point, but its material points
@@ -640,26 +707,26 @@ mod tests {
         let mut c = contact();
         assert!(c.update(&ground, xf_g, &disk, Transform::new(Vec2::new(0.0, 0.5), 0.0), 0.02));
         let rolled = Transform::new(Vec2::new(0.02, 0.5), -0.04);
-        assert!(!c.clone().recycle(xf_g, rolled, 2.0 * 0.5));
+        assert!(!c.clone().recycle(xf_g, rolled, 2.0 * 0.5, 0.0));
         // A small roll (0.01 rad: 1 cm at the reach) is within a polygon pair's limit, but
         // not within a rounded shape's (`Contact::rolling_radius` > 0), whose point rolls.
         let small = Transform::new(Vec2::new(0.005, 0.5), -0.01);
-        assert!(c.clone().recycle(xf_g, small, 2.0 * 0.5));
+        assert!(c.clone().recycle(xf_g, small, 2.0 * 0.5, 0.0));
         let round = Contact {
             rolling_radius: 0.5,
             ..c.clone()
         };
-        assert!(!round.clone().recycle(xf_g, small, 2.0 * 0.5));
+        assert!(!round.clone().recycle(xf_g, small, 2.0 * 0.5, 0.0));
         assert!(round
             .clone()
-            .recycle(xf_g, Transform::new(Vec2::new(0.002, 0.5), -0.004), 2.0 * 0.5));
+            .recycle(xf_g, Transform::new(Vec2::new(0.002, 0.5), -0.004), 2.0 * 0.5, 0.0));
         let block = Shape::Polygon(Polygon::new_box(0.5, 0.5).unwrap());
         let mut b = contact();
         assert!(b.update(&ground, xf_g, &block, Transform::new(Vec2::new(0.0, 0.5), 0.0), 0.02));
         let tipped = Transform::new(Vec2::new(0.0, 0.5), 0.5f32.to_radians());
-        assert!(!b.clone().recycle(xf_g, tipped, 2.0 * 0.71));
+        assert!(!b.clone().recycle(xf_g, tipped, 2.0 * 0.71, 0.0));
         // And the untouched pair is recycled (the test would prove nothing otherwise).
-        assert!(b.recycle(xf_g, Transform::new(Vec2::new(0.0, 0.5), 0.0), 2.0 * 0.71));
+        assert!(b.recycle(xf_g, Transform::new(Vec2::new(0.0, 0.5), 0.0), 2.0 * 0.71, 0.0));
     }
 
     #[test]

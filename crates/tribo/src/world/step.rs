@@ -8,9 +8,7 @@
 
 use super::{ContactBeginEvent, ContactEndEvent, ShapeBounds, Stopwatch, World};
 use crate::collision::broad_phase::{MOVING_TREE, STATIC_TREE};
-use crate::collision::contact::{
-    pair_key, Contact, ContactSums, Memo, NarrowOutcome, PointState, NO_COLOUR, RECYCLE_STEP,
-};
+use crate::collision::contact::{pair_key, Contact, ContactSums, Memo, NarrowOutcome, PointState, NO_COLOUR};
 use crate::dynamics::body::Body;
 use crate::dynamics::shape::ShapeRecord;
 use crate::dynamics::{mix, BodyType};
@@ -1705,14 +1703,13 @@ fn narrow_phase(
         };
     }
     // A recycled manifold keeps its points, not the speculative ones a margin grown by the
-    // pair's motion would add (a corner swinging towards a wall), so only a slow pair may
-    // keep it: a feature it lacks was further than the speculative distance when it was
-    // made, has moved by at most the recycle distance since, and closes by at most dt · rel
-    // in the step; with dt · rel ≤ `RECYCLE_STEP` it can overlap by 1 cm at most
-    // (`RECYCLE_DISTANCE`). Faster pairs are collided again (Box2D's fast bodies bypass
-    // recycling too).
-    let slow = dt * rel <= RECYCLE_STEP;
-    let now = (slow && c.recycle(ba.xf, bb.xf, 2.0 * ba.max_extent.min(bb.max_extent)))
+    // pair's motion would add (a corner swinging towards a wall), so only a pair no faster
+    // than its manifold allows may keep it: a feature it lacks was further than the margin
+    // m the manifold was made with, has moved by at most the recycle distance since, and
+    // closes by at most dt · rel in the step; with dt · rel ≤ m − slop
+    // (`RECYCLE_STEP` when m is the speculative distance) it can overlap by 1 cm at most
+    // (`RECYCLE_DISTANCE`). Faster pairs are collided again.
+    let now = c.recycle(ba.xf, bb.xf, 2.0 * ba.max_extent.min(bb.max_extent), dt * rel)
         || match (shapes.at(c.shape_a.index), shapes.at(c.shape_b.index)) {
             (Some(sa), Some(sb)) => {
                 *collided += 1;
