@@ -183,13 +183,18 @@ pub(crate) enum Memo {
     Far { bound: f32, poses: FarPoses },
 }
 
-/// The bodies' poses when a pair's distance bound ([`Memo::Far`]) was computed.
+/// The bodies' poses when a pair's distance bound ([`Memo::Far`]) was computed: in world
+/// axes, and B's relative to A's.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct FarPoses {
     /// Origin of B minus origin of A [m].
     pub d: Vec2,
     pub q_a: Rot,
     pub q_b: Rot,
+    /// B's origin in A's frame [m] (`xf_a.inv_mul(xf_b).p`).
+    pub rel_p: Vec2,
+    /// B's rotation in A's frame (`xf_a.q.inv_mul(xf_b.q)`).
+    pub rel_q: Rot,
 }
 
 /// The narrow phase's verdict on one contact in one step.
@@ -339,6 +344,8 @@ impl Contact {
                         d: xf_b.p - xf_a.p,
                         q_a: xf_a.q,
                         q_b: xf_b.q,
+                        rel_p: xf_a.q.inv_rotate(xf_b.p - xf_a.p),
+                        rel_q: xf_a.q.inv_mul(xf_b.q),
                     },
                 }
             } else {
@@ -371,12 +378,19 @@ impl Contact {
 
     /// Whether a pair found apart is still too far apart for any manifold point within
     /// `margin` [m], judged without colliding it: its distance bound minus the most its
-    /// surfaces can have closed in since, the relative motion of the body origins plus each
+    /// surfaces can have closed in since. That is the lesser of two bounds on the motion of
+    /// any shape point: in world axes, the relative motion of the body origins plus each
     /// body's turn times its reach (a point at distance R from the origin turning by Δθ moves
-    /// 2R·sin(Δθ/2) = R·|q − q₀|, exactly). `d`: origin of B minus origin of A now [m];
-    /// `reach_a`, `reach_b`: the bodies' largest distance [m] from their origin to a shape
-    /// point. When true, colliding would give the empty manifold the contact already has
-    /// (see `geometry::collide_bounded`).
+    /// 2R·sin(Δθ/2) = R·|q − q₀|, exactly); and in A's frame, where the distance is the same
+    /// (it depends only on B's pose relative to A's), the motion of B's origin there plus
+    /// B's relative turn times its reach (a point x of B moves by Δp + (q − q₀)·x as complex
+    /// numbers, at most |Δp| + |q − q₀|·|x|). The second is zero for bodies moving as one
+    /// (a pile turning with its drum: the tumbler's neighbours apart by a few centimetres
+    /// were collided again every few steps, each time apart), the first is the smaller
+    /// for A turning alone. `d`: origin of B minus origin of A now [m]; `reach_a`,
+    /// `reach_b`: the bodies' largest distance [m] from their origin to a shape point. When
+    /// true, colliding would give the empty manifold the contact already has (see
+    /// `geometry::collide_bounded`).
     #[inline(always)]
     pub fn still_apart(&self, d: Vec2, q_a: Rot, q_b: Rot, reach_a: f32, reach_b: f32, margin: f32) -> bool {
         let Memo::Far { bound, poses: f } = &self.memo else {
@@ -386,8 +400,9 @@ impl Contact {
             return false;
         }
         let turn = |q: Rot, q0: Rot| ((q.c - q0.c) * (q.c - q0.c) + (q.s - q0.s) * (q.s - q0.s)).sqrt();
-        let closed = (d - f.d).length() + reach_a * turn(q_a, f.q_a) + reach_b * turn(q_b, f.q_b);
-        *bound - closed > margin
+        let world = (d - f.d).length() + reach_a * turn(q_a, f.q_a) + reach_b * turn(q_b, f.q_b);
+        let relative = (q_a.inv_rotate(d) - f.rel_p).length() + reach_b * turn(q_a.inv_mul(q_b), f.rel_q);
+        *bound - world.min(relative) > margin
     }
 
     /// What [`Contact::update`] leaves when the shapes are too far apart for any point:
@@ -727,6 +742,48 @@ mod tests {
         assert!(!b.clone().recycle(xf_g, tipped, 2.0 * 0.71, 0.0));
         // And the untouched pair is recycled (the test would prove nothing otherwise).
         assert!(b.recycle(xf_g, Transform::new(Vec2::new(0.0, 0.5), 0.0), 2.0 * 0.71, 0.0));
+    }
+
+    /// Two boxes 3 cm apart (margin 2 cm) turning as one about a pivot 5 m away, 0.02 rad
+    /// a step (10 cm of travel), with a drift between them of 0.1 mm a step: in A's frame B
+    /// barely moves, so after the first collide the pair is judged apart at every step
+    /// until the drift has closed the 1 cm left (100 steps), each such verdict checked
+    /// against a fresh collide, and the world-axes bound alone (the turn moves the origins'
+    /// difference by 1 cm a step) would have allowed no skip at all.
+    #[test]
+    fn bodies_turning_as_one_stay_apart_without_a_collide() {
+        use crate::geometry::collide;
+        let shape = Shape::Polygon(Polygon::new_box(0.25, 0.25).unwrap());
+        let reach = shape.max_extent(Vec2::ZERO);
+        let margin = 0.02;
+        let mut c = blank_contact();
+        let pivot = Vec2::new(0.0, -5.0);
+        let (mut skipped, mut collided) = (0, 0);
+        for k in 0..90 {
+            let turn = Rot::from_angle(0.02 * k as f32);
+            let place = |x: f32| Transform {
+                p: pivot + turn.rotate(Vec2::new(x, 5.0) - pivot),
+                q: turn,
+            };
+            let (xf_a, xf_b) = (place(0.0), place(0.53 - 1e-4 * k as f32));
+            let d = xf_b.p - xf_a.p;
+            if c.still_apart(d, xf_a.q, xf_b.q, reach, reach, margin) {
+                skipped += 1;
+                assert_eq!(collide(&shape, xf_a, &shape, xf_b, margin).count, 0, "step {k}");
+                // The world-axes bound alone would not have skipped it.
+                let Memo::Far { bound, poses } = c.memo else {
+                    unreachable!()
+                };
+                let turn = |q: Rot, q0: Rot| (Vec2::new(q.c, q.s) - Vec2::new(q0.c, q0.s)).length();
+                let world = (d - poses.d).length() + reach * (turn(xf_a.q, poses.q_a) + turn(xf_b.q, poses.q_b));
+                assert!(bound - world <= margin, "step {k}");
+                continue;
+            }
+            collided += 1;
+            assert!(!c.update(&shape, xf_a, &shape, xf_b, margin), "step {k}: 1-3 cm apart");
+        }
+        assert_eq!(collided, 1, "collided again {} times", collided - 1);
+        assert_eq!(skipped, 89);
     }
 
     #[test]
