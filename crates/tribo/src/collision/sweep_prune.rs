@@ -409,8 +409,9 @@ fn sweep_sorted(
     // A box's hits (places in sweep order), written in the loop, which then calls nothing
     // (a call, even a push's rare growth, made the loop keep its vectors on the stack).
     // (Each place is written before it is read: no clearing.)
-    if hits.len() < len {
-        hits.resize(len, 0);
+    // (Room for a whole chunk past the last hit: each chunk writes all its places.)
+    if hits.len() < len + CHUNK {
+        hits.resize(len + CHUNK, 0);
     }
     let mut tests = 0usize;
     for i in 0..n {
@@ -443,13 +444,14 @@ fn sweep_sorted(
                 break;
             };
             let inside = end4.ge(F4::new(l));
-            let mut hit = (inside & c_hi4.ge(F4::new(cl)) & F4::new(ch).ge(c_lo4)).bits();
-            while hit != 0 {
+            let hit = (inside & c_hi4.ge(F4::new(cl)) & F4::new(ch).ge(c_lo4)).bits();
+            // Every place written, the count advanced by the hits only (no branch on
+            // each hit: which of a chunk's four hit is unpredictable).
+            for l in 0..CHUNK {
                 if let Some(slot) = hits.get_mut(count) {
-                    *slot = (j + hit.trailing_zeros() as usize) as u32;
+                    *slot = (j + l) as u32;
                 }
-                count += 1;
-                hit &= hit - 1;
+                count += ((hit >> l) & 1) as usize;
             }
             tests += CHUNK;
             if inside.bits() != (1 << CHUNK) - 1 {
