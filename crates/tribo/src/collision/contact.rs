@@ -236,25 +236,46 @@ pub(crate) struct RecycleBasis {
 impl RecycleBasis {
     /// The basis of `manifold`, computed with the bodies at `xf_a` and `xf_b`: each point's
     /// surface points (half the separation either side along the normal) in both frames;
-    /// `allowance` [m]: see [`RecycleBasis::allowance`].
+    /// `allowance` [m]: see [`RecycleBasis::allowance`] (tests; `Contact::recycle` makes
+    /// it in place, [`RecycleBasis::set`]).
+    #[cfg(test)]
     fn of(manifold: &Manifold, xf_a: Transform, xf_b: Transform, allowance: f32) -> RecycleBasis {
-        let mut basis = RecycleBasis {
-            allowance,
-            ..RecycleBasis::default()
-        };
-        let n = manifold.normal;
-        for i in 0..manifold.count.min(MAX_MANIFOLD_POINTS) {
-            let mp = &manifold.points[i];
-            let half = 0.5 * mp.separation * n;
-            let (surface_a, surface_b) = (mp.point - half, mp.point + half);
-            basis.local_a[i] = xf_a.inv_apply(surface_a);
-            basis.local_b[i] = xf_b.inv_apply(surface_b);
-            basis.b_in_a[i] = xf_a.inv_apply(surface_b);
-            basis.a_in_b[i] = xf_b.inv_apply(surface_a);
-        }
-        basis.rel_q = xf_a.q.inv_mul(xf_b.q);
-        basis.normal_a = xf_a.q.inv_rotate(n);
+        let mut basis = RecycleBasis::default();
+        basis.set(manifold, xf_a, xf_b, allowance);
         basis
+    }
+
+    /// Makes this the basis of `manifold` (see [`RecycleBasis::of`]), in place: every
+    /// field written, an unused point's slots zero.
+    #[inline(always)]
+    fn set(&mut self, manifold: &Manifold, xf_a: Transform, xf_b: Transform, allowance: f32) {
+        // Field by field, no record built whole: a record built on the stack and copied in
+        // reads its 16-byte halves over the narrower stores that made them (no store
+        // forwarding: a quarter of `recycle`'s samples in the tumbler waited on that copy).
+        let n = manifold.normal;
+        let count = manifold.count.min(MAX_MANIFOLD_POINTS);
+        for i in 0..MAX_MANIFOLD_POINTS {
+            let (la, lb, ba, ab) = match manifold.points.get(i).filter(|_| i < count) {
+                Some(mp) => {
+                    let half = 0.5 * mp.separation * n;
+                    let (surface_a, surface_b) = (mp.point - half, mp.point + half);
+                    (
+                        xf_a.inv_apply(surface_a),
+                        xf_b.inv_apply(surface_b),
+                        xf_a.inv_apply(surface_b),
+                        xf_b.inv_apply(surface_a),
+                    )
+                }
+                None => (Vec2::ZERO, Vec2::ZERO, Vec2::ZERO, Vec2::ZERO),
+            };
+            self.local_a[i] = la;
+            self.local_b[i] = lb;
+            self.b_in_a[i] = ba;
+            self.a_in_b[i] = ab;
+        }
+        self.rel_q = xf_a.q.inv_mul(xf_b.q);
+        self.normal_a = xf_a.q.inv_rotate(n);
+        self.allowance = allowance;
     }
 }
 
@@ -444,8 +465,11 @@ impl Contact {
             } => {
                 // The manifold is still the one computed at these poses: a recycle first
                 // makes the basis, and `update` and `clear_manifold` replace the memo with
-                // the manifold.
-                self.memo = Memo::Basis(RecycleBasis::of(&self.manifold, then_a, then_b, allowance));
+                // the manifold. (The variant set first, its basis written in place.)
+                self.memo = Memo::Basis(RecycleBasis::default());
+                if let Memo::Basis(basis) = &mut self.memo {
+                    basis.set(&self.manifold, then_a, then_b, allowance);
+                }
             }
             _ => {}
         }
