@@ -1709,6 +1709,14 @@ fn narrow_phase(
     // closes by at most dt · rel in the step; with dt · rel ≤ m − slop
     // (`RECYCLE_STEP` when m is the speculative distance) it can overlap by 1 cm at most
     // (`RECYCLE_DISTANCE`). Faster pairs are collided again.
+    // A pair without a recycling basis of its own (collided last step, or found apart)
+    // asks for both shapes' geometry now, so the two records' lines arrive together and
+    // while the recycle is tried, rather than one after the other when it fails.
+    if !matches!(c.memo, Memo::Basis(_)) {
+        for id in [c.shape_a, c.shape_b] {
+            shapes.prefetch_n(id.index, 3);
+        }
+    }
     let now = c.recycle(ba.xf, bb.xf, 2.0 * ba.max_extent.min(bb.max_extent), dt * rel)
         || match (shapes.at(c.shape_a.index), shapes.at(c.shape_b.index)) {
             (Some(sa), Some(sb)) => {
