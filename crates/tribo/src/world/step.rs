@@ -483,13 +483,14 @@ impl World {
         // recycled (a resting pile: large_pyramid 0 %) those lines would be loaded for
         // nothing (its collide +13 %).
         let geometry_ahead = self.collided_many;
-        // None of the contact ahead's data (bodies, shape bounds, geometry) is asked for
-        // unless the bodies' and bounds' arrays would crowd a core's cache
-        // ([`NEAR_PREFETCH_BYTES`]); below that the scene's data stays there, and the
-        // prefetches are just instructions, two dozen a contact (the tumbler, 0.26 MiB, with
-        // the geometry's prefetch kept alone: collide +3.1 %, 5 alternated pairs).
-        let footprint = core::mem::size_of_val(solver_bodies) + core::mem::size_of_val(bounds);
-        let near_ahead = footprint > NEAR_PREFETCH_BYTES;
+        // The contact ahead's bodies and shape bounds are asked for whatever the size of
+        // their arrays: the contact records stream through the core's L2 and push them out
+        // of it. (Until 2026-12 only above 768 KiB of bodies and bounds, three quarters of
+        // the L2 of the AMD EPYC the benchmark then ran on, where below it the prefetches
+        // were just instructions, two dozen a contact (tumbler, 0.26 MiB: collide +2.4 %
+        // with them). On the Intel Xeon since (2 MiB of L2 a core), with them at every
+        // size, alternated rounds: tumbler's collide −4 %, compounds' (0.57 MiB) −7 %,
+        // large_pyramid's (0.62 MiB) unchanged.)
         let collided_total = core::sync::atomic::AtomicU32::new(0);
         // On threads, after a step the worker team solved, each visits the contacts of the
         // groups it solved (the contacts follow the solver's layout): the candidate and key
@@ -547,7 +548,7 @@ impl World {
                     // The bodies and shape bounds of a contact a few ahead: loads that
                     // miss (contacts come in solver order, not body order) and that the
                     // narrow phase needs before anything else.
-                    if let Some(Some(ahead)) = near.filter(|_| near_ahead).and_then(|r| slots.get(r)) {
+                    if let Some(Some(ahead)) = near.and_then(|r| slots.get(r)) {
                         for bi in [ahead.body_a, ahead.body_b] {
                             if let Some(sb) = solver_bodies.get(bi as usize) {
                                 crate::solver::prefetch(sb);
@@ -1533,16 +1534,6 @@ pub(super) fn grid_owners(owners: &[(usize, usize)], grid: usize) -> Vec<(usize,
 
 /// How many contacts ahead the narrow phase asks for their bodies and shape bounds.
 const NARROW_PREFETCH: usize = 4;
-
-/// The size [bytes] of the solver bodies and shape bounds above which the narrow phase
-/// asks for the bodies, bounds and (in a pile in motion) shape geometry of the contacts a
-/// few ahead: three quarters of a core's L2 cache on the AMD EPYC the benchmark runs on
-/// (1 MiB; the contact records stream through it too). Tuned on that one machine: a core
-/// with a smaller L2 would want it lower. Collide stage without those prefetches, 2–3
-/// alternated rounds each (footprint): tumbler −2.4 % (0.26 MiB), compounds −0.8 % (0.57),
-/// large_pyramid −4.5 % (0.62); spinner +6 % (0.76, a few per cent above the line),
-/// junkyard +12 % (0.99), smash +8 % (1.17), many_pyramids +2.6 % (2.7).
-const NEAR_PREFETCH_BYTES: usize = 768 << 10;
 
 /// How many contacts ahead the narrow phase asks for the contact record itself (many_pyramids'
 /// collide, ms: 6 ahead 2.84-2.94, 12 ahead 2.44-2.63, 20 ahead 2.57-2.72).
