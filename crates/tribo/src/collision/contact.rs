@@ -5,7 +5,7 @@
 //! written back by [`crate::solver`].
 
 use crate::dynamics::MixedMaterial;
-use crate::geometry::{collide_bounded, Manifold, Shape, MAX_MANIFOLD_POINTS};
+use crate::geometry::{collide_bounded_into, Manifold, Shape, MAX_MANIFOLD_POINTS};
 use crate::geometry::{LINEAR_SLOP, SPECULATIVE_DISTANCE};
 use crate::math::wide::{apply_lanes, split_xy, F4, M4};
 use crate::math::{Rot, Transform, Vec2};
@@ -339,8 +339,15 @@ impl Contact {
     ) -> bool {
         let old_manifold = self.manifold;
         let old_points = self.points;
-        let (manifold, bound) = collide_bounded(geom_a, xf_a, geom_b, xf_b, speculative_distance, &old_manifold);
-        self.manifold = manifold;
+        let bound = collide_bounded_into(
+            geom_a,
+            xf_a,
+            geom_b,
+            xf_b,
+            speculative_distance,
+            &old_manifold,
+            &mut self.manifold,
+        );
         for i in 0..self.manifold.count {
             let id = self.manifold.points[i].id;
             let matched = (0..old_manifold.count).find(|&j| old_manifold.points[j].id == id);

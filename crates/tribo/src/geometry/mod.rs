@@ -17,7 +17,7 @@ mod shapes;
 mod sweep;
 
 pub use hull::convex_hull;
-pub(crate) use manifold::collide_bounded;
+pub(crate) use manifold::collide_bounded_into;
 pub use manifold::{collide, collide_after, Manifold, ManifoldPoint, MAX_MANIFOLD_POINTS};
 pub use mass::MassData;
 pub use raycast::{RayCastInput, RayHit};

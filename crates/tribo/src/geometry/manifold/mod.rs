@@ -132,6 +132,34 @@ pub fn collide_after(
 /// The bound is the separating-axis separation that rejected the pair (pairs of polygons,
 /// capsules and segments through `polygon_polygon`, polygon–circle) or the exact distance
 /// (circle, capsule and segment pairs by their closest points).
+/// [`collide_bounded`] with the manifold written into `out` (the contact's own), in place
+/// for the common pair of two polygons (see [`LocalManifold::write_world`]); returns the
+/// bound.
+pub(crate) fn collide_bounded_into(
+    shape_a: &Shape,
+    xf_a: Transform,
+    shape_b: &Shape,
+    xf_b: Transform,
+    speculative_distance: f32,
+    last: &Manifold,
+    out: &mut Manifold,
+) -> f32 {
+    if let (Shape::Polygon(a), Shape::Polygon(b)) = (shape_a, shape_b) {
+        return polygon_polygon::collide_polygons_into(
+            a,
+            xf_a,
+            b,
+            xf_b,
+            speculative_distance,
+            last_reference_b(last),
+            out,
+        );
+    }
+    let (m, bound) = collide_bounded(shape_a, xf_a, shape_b, xf_b, speculative_distance, last);
+    *out = m;
+    bound
+}
+
 pub(crate) fn collide_bounded(
     shape_a: &Shape,
     xf_a: Transform,
@@ -292,27 +320,50 @@ impl LocalManifold {
     /// from a nearby one); with the separation bound of an empty manifold.
     fn to_world(self, xf_a: Transform, xf_b: Transform) -> (Manifold, f32) {
         let mut m = Manifold::EMPTY;
-        if self.count == 0 {
-            return (m, self.bound);
-        }
-        m.normal = xf_a.q.rotate(self.normal);
+        let bound = self.write_world(xf_a, xf_b, &mut m);
+        (m, bound)
+    }
+
+    /// [`LocalManifold::to_world`] written into `m` in place, field by field (what the
+    /// narrow phase's contact update takes: a manifold returned by value was copied out of
+    /// the callee's frame by 16-byte loads over the narrower stores that had just made
+    /// it, which cannot be forwarded; a third of `Contact::update`'s samples in the
+    /// tumbler). Returns the separation bound.
+    #[inline(always)]
+    fn write_world(&self, xf_a: Transform, xf_b: Transform, m: &mut Manifold) -> f32 {
+        let count = self.count.min(MAX_MANIFOLD_POINTS);
+        let normal = if count == 0 {
+            Vec2::ZERO
+        } else {
+            xf_a.q.rotate(self.normal)
+        };
+        m.normal = normal;
         let dp = xf_a.p - xf_b.p;
-        for (out, lp) in m
-            .points
-            .iter_mut()
-            .zip(&self.points[..self.count.min(MAX_MANIFOLD_POINTS)])
-        {
-            let anchor_a = xf_a.q.rotate(lp.point);
-            *out = ManifoldPoint {
-                point: xf_a.p + anchor_a,
-                anchor_a,
-                anchor_b: anchor_a + dp,
-                separation: lp.separation,
-                id: lp.id,
-            };
+        for (i, out) in m.points.iter_mut().enumerate() {
+            match self.points.get(i).filter(|_| i < count) {
+                Some(lp) => {
+                    let anchor_a = xf_a.q.rotate(lp.point);
+                    out.point = xf_a.p + anchor_a;
+                    out.anchor_a = anchor_a;
+                    out.anchor_b = anchor_a + dp;
+                    out.separation = lp.separation;
+                    out.id = lp.id;
+                }
+                None => {
+                    out.point = Vec2::ZERO;
+                    out.anchor_a = Vec2::ZERO;
+                    out.anchor_b = Vec2::ZERO;
+                    out.separation = 0.0;
+                    out.id = 0;
+                }
+            }
         }
-        m.count = self.count.min(MAX_MANIFOLD_POINTS);
-        (m, 0.0)
+        m.count = count;
+        if count == 0 {
+            self.bound
+        } else {
+            0.0
+        }
     }
 
     /// Adds a point as [`LocalManifold::push`] does; when it is too far for the manifold,

@@ -367,9 +367,24 @@ pub(super) fn collide_polygons(
     spec: f32,
     last_reference_b: Option<bool>,
 ) -> (Manifold, f32) {
+    let mut m = Manifold::EMPTY;
+    let bound = collide_polygons_into(a, xf_a, b, xf_b, spec, last_reference_b, &mut m);
+    (m, bound)
+}
+
+/// [`collide_polygons`] with the manifold written into `out` in place; returns the bound.
+pub(super) fn collide_polygons_into(
+    a: &Polygon,
+    xf_a: Transform,
+    b: &Polygon,
+    xf_b: Transform,
+    spec: f32,
+    last_reference_b: Option<bool>,
+    out: &mut Manifold,
+) -> f32 {
     let la = LocalPoly::of_polygon(a);
     let lb = LocalPoly::from_polygon(b, xf_a.inv_mul(xf_b));
-    collide_polygons_local(&la, &lb, spec, last_reference_b).to_world(xf_a, xf_b)
+    collide_polygons_local(&la, &lb, spec, last_reference_b).write_world(xf_a, xf_b, out)
 }
 
 #[cfg(test)]
