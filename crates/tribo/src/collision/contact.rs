@@ -170,9 +170,10 @@ pub(crate) enum Memo {
     /// A touching pair's poses when its manifold was computed, from which
     /// [`Contact::recycle`] makes the [`Memo::Basis`] the first time it tries to reuse the
     /// manifold, and the manifold's step allowance (see [`RecycleBasis::allowance`]). A
-    /// pair moving faster than that is collided again without trying, so it never needs a
-    /// basis: in smash, junkyard and the tumbler many full collisions are of such pairs,
-    /// and making the basis each time was a tenth of a full collision's instructions.
+    /// pair moving faster than that is refused before a basis is made, so it never needs
+    /// one: in smash, junkyard and the tumbler many full collisions are of pairs that never
+    /// recycle, and making the basis each time was a tenth of a full collision's
+    /// instructions.
     Posed {
         xf_a: Transform,
         xf_b: Transform,
@@ -245,7 +246,9 @@ impl RecycleBasis {
         basis
     }
 
-    /// Makes this the basis of `manifold` (see [`RecycleBasis::of`]), in place: every
+    /// Makes this the basis of `manifold`, computed with the bodies at `xf_a` and `xf_b`
+    /// (each point's surface points, half the separation either side along the normal, in
+    /// both frames; `allowance` [m]: see [`RecycleBasis::allowance`]), in place: every
     /// field written, an unused point's slots zero.
     #[inline(always)]
     fn set(&mut self, manifold: &Manifold, xf_a: Transform, xf_b: Transform, allowance: f32) {
@@ -462,7 +465,8 @@ impl Contact {
             return false;
         }
         match self.memo {
-            Memo::Posed { allowance, .. } | Memo::Basis(RecycleBasis { allowance, .. }) if step > allowance => {
+            // (Written so that a NaN step or allowance refuses.)
+            Memo::Posed { allowance, .. } | Memo::Basis(RecycleBasis { allowance, .. }) if !(step <= allowance) => {
                 return false
             }
             Memo::Posed {
@@ -683,7 +687,12 @@ mod tests {
         for (margin, allowance) in [(SPECULATIVE_DISTANCE, RECYCLE_STEP), (0.05, 0.045)] {
             let mut c = contact();
             assert!(c.update(&ground, xf_g, &block, xf_b, margin));
-            assert!((allowance - (margin - LINEAR_SLOP)).abs() < 1e-7);
+            let Memo::Posed { allowance: kept, .. } = c.memo else {
+                panic!("a touching pair keeps its poses")
+            };
+            assert!((kept - allowance).abs() < 1e-6 && (kept - (margin - LINEAR_SLOP)).abs() < 1e-6);
+            // A step that is not a number is refused.
+            assert!(!c.clone().recycle(xf_g, xf_b, 2.0 * 0.71, f32::NAN));
             assert!(
                 !c.clone().recycle(xf_g, xf_b, 2.0 * 0.71, allowance + 1e-4),
                 "margin {margin}"
@@ -775,46 +784,89 @@ mod tests {
         assert!(b.recycle(xf_g, Transform::new(Vec2::new(0.0, 0.5), 0.0), 2.0 * 0.71, 0.0));
     }
 
-    /// Two boxes 3 cm apart (margin 2 cm) turning as one about a pivot 5 m away, 0.02 rad
-    /// a step (10 cm of travel), with a drift between them of 0.1 mm a step: in A's frame B
-    /// barely moves, so after the first collide the pair is judged apart at every step
-    /// until the drift has closed the 1 cm left (100 steps), each such verdict checked
-    /// against a fresh collide, and the world-axes bound alone (the turn moves the origins'
-    /// difference by 1 cm a step) would have allowed no skip at all.
-    #[test]
-    fn bodies_turning_as_one_stay_apart_without_a_collide() {
+    /// Steps a pair through `poses(k)` (A's, B's) for `steps` steps, as the narrow phase
+    /// does: each step the contact is either judged still apart, which a fresh collide at
+    /// that pose must confirm (an empty manifold), or collided. Returns (steps judged apart,
+    /// of them those the world-axes bound alone would not have judged apart, the step the
+    /// pair first touched).
+    fn judge_apart(
+        a_shape: &Shape,
+        b_shape: &Shape,
+        steps: usize,
+        poses: impl Fn(usize) -> (Transform, Transform),
+    ) -> (usize, usize, Option<usize>) {
         use crate::geometry::collide;
-        let shape = Shape::Polygon(Polygon::new_box(0.25, 0.25).unwrap());
-        let reach = shape.max_extent(Vec2::ZERO);
+        let (reach_a, reach_b) = (a_shape.max_extent(Vec2::ZERO), b_shape.max_extent(Vec2::ZERO));
         let margin = 0.02;
         let mut c = blank_contact();
-        let pivot = Vec2::new(0.0, -5.0);
-        let (mut skipped, mut collided) = (0, 0);
-        for k in 0..90 {
-            let turn = Rot::from_angle(0.02 * k as f32);
-            let place = |x: f32| Transform {
-                p: pivot + turn.rotate(Vec2::new(x, 5.0) - pivot),
-                q: turn,
-            };
-            let (xf_a, xf_b) = (place(0.0), place(0.53 - 1e-4 * k as f32));
+        let (mut skipped, mut by_relative) = (0, 0);
+        for k in 0..steps {
+            let (xf_a, xf_b) = poses(k);
             let d = xf_b.p - xf_a.p;
-            if c.still_apart(d, xf_a.q, xf_b.q, reach, reach, margin) {
+            if c.still_apart(d, xf_a.q, xf_b.q, reach_a, reach_b, margin) {
                 skipped += 1;
-                assert_eq!(collide(&shape, xf_a, &shape, xf_b, margin).count, 0, "step {k}");
-                // The world-axes bound alone would not have skipped it.
-                let Memo::Far { bound, poses } = c.memo else {
+                assert_eq!(collide(a_shape, xf_a, b_shape, xf_b, margin).count, 0, "step {k}");
+                let Memo::Far { bound, poses: f } = c.memo else {
                     unreachable!()
                 };
                 let turn = |q: Rot, q0: Rot| (Vec2::new(q.c, q.s) - Vec2::new(q0.c, q0.s)).length();
-                let world = (d - poses.d).length() + reach * (turn(xf_a.q, poses.q_a) + turn(xf_b.q, poses.q_b));
-                assert!(bound - world <= margin, "step {k}");
+                let world = (d - f.d).length() + reach_a * turn(xf_a.q, f.q_a) + reach_b * turn(xf_b.q, f.q_b);
+                by_relative += usize::from(bound - world <= margin);
                 continue;
             }
-            collided += 1;
-            assert!(!c.update(&shape, xf_a, &shape, xf_b, margin), "step {k}: 1-3 cm apart");
+            if c.update(a_shape, xf_a, b_shape, xf_b, margin) {
+                return (skipped, by_relative, Some(k));
+            }
         }
-        assert_eq!(collided, 1, "collided again {} times", collided - 1);
-        assert_eq!(skipped, 89);
+        (skipped, by_relative, None)
+    }
+
+    /// Bodies moving as one are judged apart by B's motion in A's frame, which is zero,
+    /// and every such verdict is confirmed by a fresh collide; the skips never hide an
+    /// approach. Two boxes 3 cm apart (margin 2 cm) turn as one about a pivot 5 m away,
+    /// 0.02 rad a step (10 cm of travel), drifting together by 0.1 mm a step: collided at
+    /// the first step, then judged apart (the world-axes bound alone, with the origins'
+    /// difference turning by 1 cm a step, would have skipped none of them) until the drift
+    /// has used up the centimetre left, and touching (a speculative point) once the gap is
+    /// under the margin, at step 100. Then B's box, offset 0.35 m from B's origin, turns
+    /// about that origin 0.02 rad a step while the pair turns as above, so B's relative turn
+    /// times its reach bounds the closing: again every skip confirmed, and the pair touches
+    /// as the box swings round to A's face.
+    #[test]
+    fn bodies_turning_as_one_stay_apart_without_a_collide() {
+        let square = |h: f32, at: Vec2| {
+            let corners = [Vec2::new(-h, -h), Vec2::new(h, -h), Vec2::new(h, h), Vec2::new(-h, h)];
+            Shape::Polygon(Polygon::from_points(&corners.map(|p| p + at), 0.0).unwrap())
+        };
+        let pivot = Vec2::new(0.0, -5.0);
+        let turned = |k: usize, x: f32, spin: f32| {
+            let turn = Rot::from_angle(0.02 * k as f32);
+            Transform {
+                p: pivot + turn.rotate(Vec2::new(x, 5.0) - pivot),
+                q: Rot::from_angle(0.02 * k as f32 + spin),
+            }
+        };
+        let a = square(0.25, Vec2::ZERO);
+        let drifting = |k: usize| (turned(k, 0.0, 0.0), turned(k, 0.53 - 1e-4 * k as f32, 0.0));
+        let (skipped, by_relative, touched) = judge_apart(&a, &a, 130, drifting);
+        // The gap reaches the margin at step 100: judged apart at steps 1-99 (less a step
+        // or two of rounding near the boundary).
+        assert!((97..=99).contains(&skipped), "judged apart at {skipped} steps");
+        assert_eq!(by_relative, skipped);
+        // The gap is 3 cm − 0.1 mm · k, under the 2 cm margin from step 101.
+        assert!(
+            touched.is_some_and(|k| (99..=101).contains(&k)),
+            "touched at {touched:?}"
+        );
+        // B's box offset from its origin, spinning about it.
+        let offset = square(0.1, Vec2::new(0.35, 0.0));
+        let spinning = |k: usize| (turned(k, 0.0, 0.0), turned(k, 0.7, 0.02 * k as f32));
+        let (skipped, by_relative, touched) = judge_apart(&a, &offset, 200, spinning);
+        assert!(
+            skipped > 50 && by_relative > 0,
+            "{skipped} skipped, {by_relative} by the relative bound"
+        );
+        assert!(touched.is_some(), "the box never reached A");
     }
 
     #[test]

@@ -132,34 +132,6 @@ pub fn collide_after(
 /// The bound is the separating-axis separation that rejected the pair (pairs of polygons,
 /// capsules and segments through `polygon_polygon`, polygon–circle) or the exact distance
 /// (circle, capsule and segment pairs by their closest points).
-/// [`collide_bounded`] with the manifold written into `out` (the contact's own), in place
-/// for the common pair of two polygons (see [`LocalManifold::write_world`]); returns the
-/// bound.
-pub(crate) fn collide_bounded_into(
-    shape_a: &Shape,
-    xf_a: Transform,
-    shape_b: &Shape,
-    xf_b: Transform,
-    speculative_distance: f32,
-    last: &Manifold,
-    out: &mut Manifold,
-) -> f32 {
-    if let (Shape::Polygon(a), Shape::Polygon(b)) = (shape_a, shape_b) {
-        return polygon_polygon::collide_polygons_into(
-            a,
-            xf_a,
-            b,
-            xf_b,
-            speculative_distance,
-            last_reference_b(last),
-            out,
-        );
-    }
-    let (m, bound) = collide_bounded(shape_a, xf_a, shape_b, xf_b, speculative_distance, last);
-    *out = m;
-    bound
-}
-
 pub(crate) fn collide_bounded(
     shape_a: &Shape,
     xf_a: Transform,
@@ -227,6 +199,34 @@ pub(crate) fn collide_bounded(
             (Manifold::EMPTY, 0.0)
         }
     }
+}
+
+/// [`collide_bounded`] with the manifold written into `out` (the contact's own), in place
+/// for the common pair of two polygons (see [`LocalManifold::write_world`]); returns the
+/// bound.
+pub(crate) fn collide_bounded_into(
+    shape_a: &Shape,
+    xf_a: Transform,
+    shape_b: &Shape,
+    xf_b: Transform,
+    speculative_distance: f32,
+    last: &Manifold,
+    out: &mut Manifold,
+) -> f32 {
+    if let (Shape::Polygon(a), Shape::Polygon(b)) = (shape_a, shape_b) {
+        return polygon_polygon::collide_polygons_into(
+            a,
+            xf_a,
+            b,
+            xf_b,
+            speculative_distance,
+            last_reference_b(last),
+            out,
+        );
+    }
+    let (m, bound) = collide_bounded(shape_a, xf_a, shape_b, xf_b, speculative_distance, last);
+    *out = m;
+    bound
 }
 
 /// Which polygon's face the last manifold of a polygon pair clipped against (`Some(true)`:
