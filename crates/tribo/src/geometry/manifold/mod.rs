@@ -161,7 +161,9 @@ pub(crate) fn collide_bounded(
         (Shape::Polygon(a), Shape::Circle(b)) => polygon_circle::collide_polygon_circle(a, xf_a, b, xf_b, spec),
         (Shape::Polygon(a), Shape::Capsule(b)) => polygon_capsule::collide_polygon_capsule(a, xf_a, b, xf_b, spec),
         (Shape::Polygon(a), Shape::Polygon(b)) => {
-            polygon_polygon::collide_polygons(a, xf_a, b, xf_b, spec, last_reference_b(last))
+            let mut m = Manifold::EMPTY;
+            let bound = polygon_polygon::collide_polygons_into(a, xf_a, b, xf_b, spec, last_reference_b(last), &mut m);
+            (m, bound)
         }
         (Shape::Polygon(a), Shape::Segment(b)) => polygon_segment::collide_polygon_segment(a, xf_a, b, xf_b, spec),
 

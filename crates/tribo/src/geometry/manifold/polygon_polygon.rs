@@ -356,23 +356,10 @@ pub(super) fn collide_polygons_local(
     }
 }
 
-/// Contact between polygons `a` (placed by `xf_a`) and `b` (placed by `xf_b`), and the
-/// separation bound of an empty manifold (see `collide_bounded`); `last_reference_b` as in
+/// Contact between polygons `a` (placed by `xf_a`) and `b` (placed by `xf_b`), written
+/// into `out` in place (see `LocalManifold::write_world`), and the separation bound of an
+/// empty manifold (see `collide_bounded`); `last_reference_b` as in
 /// [`collide_polygons_local`].
-pub(super) fn collide_polygons(
-    a: &Polygon,
-    xf_a: Transform,
-    b: &Polygon,
-    xf_b: Transform,
-    spec: f32,
-    last_reference_b: Option<bool>,
-) -> (Manifold, f32) {
-    let mut m = Manifold::EMPTY;
-    let bound = collide_polygons_into(a, xf_a, b, xf_b, spec, last_reference_b, &mut m);
-    (m, bound)
-}
-
-/// [`collide_polygons`] with the manifold written into `out` in place; returns the bound.
 pub(super) fn collide_polygons_into(
     a: &Polygon,
     xf_a: Transform,
