@@ -431,9 +431,13 @@ impl Contact {
             return false;
         }
         let turn = |q: Rot, q0: Rot| ((q.c - q0.c) * (q.c - q0.c) + (q.s - q0.s) * (q.s - q0.s)).sqrt();
-        let world = (d - f.d).length() + reach_a * turn(q_a, f.q_a) + reach_b * turn(q_b, f.q_b);
+        // `bound − min(relative, world) > margin`, the second bound computed only when the
+        // first does not decide (the same verdict: the subtraction is monotone).
         let relative = (q_a.inv_rotate(d) - f.rel_p).length() + reach_b * turn(q_a.inv_mul(q_b), f.rel_q);
-        *bound - world.min(relative) > margin
+        *bound - relative > margin || {
+            let world = (d - f.d).length() + reach_a * turn(q_a, f.q_a) + reach_b * turn(q_b, f.q_b);
+            *bound - world > margin
+        }
     }
 
     /// What [`Contact::update`] leaves when the shapes are too far apart for any point:

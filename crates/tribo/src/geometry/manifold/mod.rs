@@ -351,13 +351,7 @@ impl LocalManifold {
                     out.separation = lp.separation;
                     out.id = lp.id;
                 }
-                None => {
-                    out.point = Vec2::ZERO;
-                    out.anchor_a = Vec2::ZERO;
-                    out.anchor_b = Vec2::ZERO;
-                    out.separation = 0.0;
-                    out.id = 0;
-                }
+                None => *out = ManifoldPoint::default(),
             }
         }
         m.count = count;
