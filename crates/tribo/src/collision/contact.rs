@@ -48,6 +48,16 @@ pub(crate) struct PointState {
 }
 
 impl PointState {
+    /// A point with no history: sticking, no impulses (the `Default`).
+    pub const BLANK: PointState = PointState {
+        normal_impulse: 0.0,
+        tangent_impulse: 0.0,
+        drift: 0.0,
+        preload: 0.0,
+        state: FrictionState::Stick,
+        fresh: false,
+    };
+
     /// Sets what the impulse store writes: `carried` = (normal [N·s], tangent [N·s], drift
     /// [m], preload [N·s]), the friction state, and `fresh` off. Field by field in layout
     /// order, so the row compiles to one 16-byte store.
@@ -144,6 +154,33 @@ pub(crate) struct Contact {
 }
 
 const _: () = assert!(core::mem::size_of::<Contact>() == 320);
+
+impl Contact {
+    /// A new contact's record before its pair is written in (`World::create_contact`):
+    /// not touching, no colour, an empty manifold, nothing to reuse, no impulses.
+    pub const BLANK: Contact = Contact {
+        touching: false,
+        colour: NO_COLOUR,
+        body_a: 0,
+        body_b: 0,
+        rolling_impulse: 0.0,
+        rolling_radius: 0.0,
+        points: [PointState::BLANK; MAX_MANIFOLD_POINTS],
+        manifold: Manifold::EMPTY,
+        material: MixedMaterial::NONE,
+        shape_a: ShapeId {
+            index: 0,
+            generation: 0,
+        },
+        shape_b: ShapeId {
+            index: 0,
+            generation: 0,
+        },
+        memo: Memo::None,
+        list_pos: [0; 2],
+    };
+}
+
 // Everything the impulse store writes (colour, rolling impulse, the point states) lies in
 // the record's first cache line.
 const _: () =
@@ -560,30 +597,13 @@ pub(crate) fn pair_key(a: u32, b: u32) -> u64 {
     ((lo as u64) << 32) | hi as u64
 }
 
-/// A contact record with nothing in it (tests).
+/// A blank contact record between shapes 0 and 1 of bodies 0 and 1 (tests).
 #[cfg(test)]
 pub(crate) fn blank_contact() -> Contact {
-    Contact {
-        shape_a: ShapeId {
-            index: 0,
-            generation: 0,
-        },
-        shape_b: ShapeId {
-            index: 1,
-            generation: 0,
-        },
-        body_a: 0,
-        body_b: 1,
-        colour: NO_COLOUR,
-        manifold: Manifold::default(),
-        points: [PointState::default(); MAX_MANIFOLD_POINTS],
-        material: MixedMaterial::default(),
-        list_pos: [0; 2],
-        rolling_radius: 0.0,
-        rolling_impulse: 0.0,
-        touching: false,
-        memo: Memo::None,
-    }
+    let mut c = Contact::BLANK;
+    c.shape_b.index = 1;
+    c.body_b = 1;
+    c
 }
 
 #[cfg(test)]
@@ -594,6 +614,21 @@ mod tests {
 
     fn contact() -> Contact {
         blank_contact()
+    }
+
+    /// The blank record a new contact starts from holds what each part's `Default` holds
+    /// (the record is written over it field by field, so a part left out of the blank would
+    /// be garbage in every new contact): compared part by part, as `Contact` has no
+    /// equality.
+    #[test]
+    fn a_blank_contact_is_every_part_default() {
+        let c = Contact::BLANK;
+        assert_eq!(c.points, [PointState::default(); MAX_MANIFOLD_POINTS]);
+        assert_eq!(c.manifold, Manifold::default());
+        assert_eq!(c.material, MixedMaterial::default());
+        assert_eq!(c.memo, Memo::default());
+        assert_eq!((c.touching, c.colour), (false, NO_COLOUR));
+        assert_eq!((c.rolling_impulse, c.rolling_radius, c.list_pos), (0.0, 0.0, [0, 0]));
     }
 
     /// `c` (a ground–block contact) recycled for the block at `moved` and collided afresh

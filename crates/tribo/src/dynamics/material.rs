@@ -185,8 +185,25 @@ pub struct MixedMaterial {
     pub tangent_speed: f32,
 }
 
+impl MixedMaterial {
+    /// All coefficients zero (the `Default`).
+    pub const NONE: MixedMaterial = MixedMaterial {
+        friction_static: 0.0,
+        friction_dynamic: 0.0,
+        restitution: 0.0,
+        restitution_threshold: 0.0,
+        rolling_resistance: 0.0,
+        tangent_speed: 0.0,
+    };
+}
+
 /// Mixes two materials by their combine rules. Both coefficients of friction use the same
 /// rule; μs ≥ μd holds for the result because every rule is monotone in each argument.
+///
+/// Always inlined: called, it returned its result through memory, and the caller's wider
+/// loads of its 4-byte stores could not be forwarded (`World::create_contact` waited on
+/// them: a fifth of the samples of the step's own code in the tumbler).
+#[inline(always)]
 pub fn mix(a: &Material, b: &Material) -> MixedMaterial {
     let fr = CombineRule::resolve(a.friction_combine, b.friction_combine, CombineRule::GeometricMean);
     let rr = CombineRule::resolve(a.restitution_combine, b.restitution_combine, CombineRule::Max);

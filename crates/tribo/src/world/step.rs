@@ -8,12 +8,12 @@
 
 use super::{ContactBeginEvent, ContactEndEvent, ShapeBounds, Stopwatch, World};
 use crate::collision::broad_phase::{MOVING_TREE, STATIC_TREE};
-use crate::collision::contact::{pair_key, Contact, ContactSums, Memo, NarrowOutcome, PointState, NO_COLOUR};
+use crate::collision::contact::{pair_key, Contact, ContactSums, Memo, NarrowOutcome};
 use crate::dynamics::body::Body;
 use crate::dynamics::shape::ShapeRecord;
 use crate::dynamics::{mix, BodyType};
 use crate::error::{Error, Result};
-use crate::geometry::{Manifold, Shape, SPECULATIVE_DISTANCE};
+use crate::geometry::{Shape, SPECULATIVE_DISTANCE};
 use crate::math::{Rot, Vec2};
 use crate::solver::candidates::{Candidate, Candidates, ColourKey};
 use crate::solver::WideContacts;
@@ -364,42 +364,45 @@ impl World {
         let (Some(a), Some(b)) = (self.shapes.at(sa), self.shapes.at(sb)) else {
             return;
         };
-        let contact = Contact {
-            shape_a: super::ShapeId {
+        let (body_a, body_b) = (a.body.index, b.body.index);
+        let list_pos = [body_a, body_b].map(|bi| self.bodies.at(bi).map_or(0, |b| b.contacts.len() as u32));
+        let (shape_a, shape_b) = (
+            super::ShapeId {
                 index: sa,
                 generation: self.shapes.generation(sa),
             },
-            shape_b: super::ShapeId {
+            super::ShapeId {
                 index: sb,
                 generation: self.shapes.generation(sb),
             },
-            body_a: a.body.index,
-            body_b: b.body.index,
-            manifold: Manifold::default(),
-            points: [PointState::default(); 2],
-            material: mix(&a.material, &b.material),
-            rolling_radius: rolling_radius(&a.geometry).max(rolling_radius(&b.geometry)),
-            rolling_impulse: 0.0,
-            touching: false,
-            colour: NO_COLOUR,
-            memo: Memo::None,
-            list_pos: [a.body.index, b.body.index].map(|bi| self.bodies.at(bi).map_or(0, |b| b.contacts.len() as u32)),
-        };
-        let (body_a, body_b) = (contact.body_a, contact.body_b);
+        );
         let ci = match self.contact_free.pop() {
             Some(i) => {
-                self.contacts[i as usize] = Some(contact);
                 if let Some(sums) = self.contact_sums.get_mut(i as usize) {
                     *sums = ContactSums::default();
                 }
                 i
             }
             None => {
-                self.contacts.push(Some(contact));
+                self.contacts.push(None);
                 self.contact_sums.resize(self.contacts.len(), ContactSums::default());
                 (self.contacts.len() - 1) as u32
             }
         };
+        // Written in place over a blank record, field by field: the 320-byte record built
+        // on the stack and then copied into its slot had its 16-byte loads wait on the
+        // narrower stores that made it, which cannot be forwarded (a fifth of the samples
+        // of `run_step`'s own code in the tumbler, which makes contacts every step).
+        let Some(slot) = self.contacts.get_mut(ci as usize) else {
+            return;
+        };
+        let c = slot.insert(Contact::BLANK);
+        (c.shape_a, c.shape_b) = (shape_a, shape_b);
+        (c.body_a, c.body_b) = (body_a, body_b);
+        // (Mixed straight into the record: `mix` is inlined, see there.)
+        c.material = mix(&a.material, &b.material);
+        c.rolling_radius = rolling_radius(&a.geometry).max(rolling_radius(&b.geometry));
+        c.list_pos = list_pos;
         self.broad_phase.pairs.insert(pair_key(sa, sb), ci);
         for bi in [body_a, body_b] {
             // Only the contact lists, which no solver entry reads: not a write the body
