@@ -66,15 +66,18 @@ fn face_contact(
     } else {
         (i2, i1, 1, 0)
     };
-    let (pts, count) = clip_incident_edge(v11, v12, n, r_ref, v21, v22, i21, i22, r_inc, spec)?;
-    if count < 2 {
+    let mut pts = [(Vec2::ZERO, 0.0, edge, 0); 2];
+    let mut count = 0;
+    let clipped = clip_incident_edge(v11, v12, n, r_ref, v21, v22, i21, i22, r_inc, spec, |p| {
+        if let Some(slot) = pts.get_mut(count) {
+            *slot = (p.point, p.separation, edge, p.incident_vertex);
+        }
+        count += 1;
+    });
+    if !clipped || count < 2 {
         return None;
     }
-    let out = [
-        (pts[0].point, pts[0].separation, edge, pts[0].incident_vertex),
-        (pts[1].point, pts[1].separation, edge, pts[1].incident_vertex),
-    ];
-    Some((n, out))
+    Some((n, pts))
 }
 
 /// Core `a1`–`a2` with radius `ra` against core `b1`–`b2` with radius `rb`, in A's frame.

@@ -223,18 +223,26 @@ fn clip_on_face(piece: &Piece, b: &LocalPoly, spec: f32) -> LocalManifold {
     let inc = incident_edge(b, n);
     let (i21, i22) = (inc, (inc + 1) % b.count.max(1));
     let mut m = LocalManifold::new(n);
-    if let Some((points, count)) =
-        clip_incident_edge(piece.p1, piece.p2, n, 0.0, b.v[i21], b.v[i22], i21, i22, b.radius, spec)
-    {
-        for p in &points[..count] {
+    clip_incident_edge(
+        piece.p1,
+        piece.p2,
+        n,
+        0.0,
+        b.v[i21],
+        b.v[i22],
+        i21,
+        i22,
+        b.radius,
+        spec,
+        |p| {
             m.push(
                 p.point,
                 p.separation,
                 feature_id(KIND_CLIP_REF_A, 0, p.incident_vertex),
                 spec,
             );
-        }
-    }
+        },
+    );
     m
 }
 
