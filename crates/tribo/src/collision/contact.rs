@@ -167,7 +167,7 @@ impl Contact {
         rolling_radius: 0.0,
         points: [PointState::BLANK; MAX_MANIFOLD_POINTS],
         manifold: Manifold::EMPTY,
-        material: MixedMaterial::NONE,
+        material: MixedMaterial::BLANK,
         shape_a: ShapeId {
             index: 0,
             generation: 0,
@@ -616,9 +616,9 @@ mod tests {
         blank_contact()
     }
 
-    /// The blank record a new contact starts from holds what each part's `Default` holds
-    /// (the record is written over it field by field, so a part left out of the blank would
-    /// be garbage in every new contact): compared part by part, as `Contact` has no
+    /// The blank record a new contact starts from holds what each part's `Default` holds,
+    /// which the record built whole before it used (a `Default` changed later would
+    /// otherwise part from the blank): compared part by part, as `Contact` has no
     /// equality.
     #[test]
     fn a_blank_contact_is_every_part_default() {

@@ -186,8 +186,8 @@ pub struct MixedMaterial {
 }
 
 impl MixedMaterial {
-    /// All coefficients zero (the `Default`).
-    pub const NONE: MixedMaterial = MixedMaterial {
+    /// All coefficients zero (the `Default`): a new contact's blank record.
+    pub(crate) const BLANK: MixedMaterial = MixedMaterial {
         friction_static: 0.0,
         friction_dynamic: 0.0,
         restitution: 0.0,
@@ -202,7 +202,7 @@ impl MixedMaterial {
 ///
 /// Always inlined: called, it returned its result through memory, and the caller's wider
 /// loads of its 4-byte stores could not be forwarded (`World::create_contact` waited on
-/// them: a fifth of the samples of the step's own code in the tumbler).
+/// them, see there).
 #[inline(always)]
 pub fn mix(a: &Material, b: &Material) -> MixedMaterial {
     let fr = CombineRule::resolve(a.friction_combine, b.friction_combine, CombineRule::GeometricMean);

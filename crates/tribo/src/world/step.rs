@@ -391,9 +391,13 @@ impl World {
         };
         // Written in place over a blank record, field by field: the 320-byte record built
         // on the stack and then copied into its slot had its 16-byte loads wait on the
-        // narrower stores that made it, which cannot be forwarded (a fifth of the samples
-        // of `run_step`'s own code in the tumbler, which makes contacts every step).
+        // narrower stores that made it, which cannot be forwarded (that copy and `mix`'s,
+        // see there, were together a fifth of the samples of `run_step`'s own code in the
+        // tumbler, which makes contacts every step).
         let Some(slot) = self.contacts.get_mut(ci as usize) else {
+            // (Unreachable: the slot was just pushed, or came from the free list, which
+            // only holds slots of the list and is cleared when the list is cut.)
+            debug_assert!(false, "contact slot {ci} out of range");
             return;
         };
         let c = slot.insert(Contact::BLANK);

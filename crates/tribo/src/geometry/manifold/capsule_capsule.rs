@@ -66,6 +66,7 @@ fn face_contact(
     } else {
         (i2, i1, 1, 0)
     };
+    // (`emit` runs at most twice: `count` ends at most 2.)
     let mut pts = [(Vec2::ZERO, 0.0, edge, 0); 2];
     let mut count = 0;
     let clipped = clip_incident_edge(v11, v12, n, r_ref, v21, v22, i21, i22, r_inc, spec, |p| {

@@ -454,7 +454,7 @@ fn closest_on_segment(p: Vec2, a: Vec2, b: Vec2) -> (Vec2, f32) {
 }
 
 /// A point produced by clipping an incident edge against a reference edge.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 struct ClipPoint {
     /// Midway point [m].
     point: Vec2,
@@ -478,9 +478,10 @@ struct ClipPoint {
 /// Returns false when the incident edge lies wholly outside the slab (the caller then falls
 /// back to closest features); otherwise gives each of the up-to-2 points closer than `spec`
 /// to `emit`, in order (the end near `v11` first), and returns true. Given to the caller's
-/// closure rather than returned in an array: the array, made on the stack by narrow stores
-/// and copied out by 16-byte loads, waited on store forwarding (a sixth of this function's
-/// samples in the tumbler).
+/// closure, inlined into each caller, rather than returned in an array: the array, made on
+/// the stack by narrow stores and copied out by 16-byte loads, waited on store forwarding
+/// (a sixth of this function's samples in the tumbler, when it was a function of its own;
+/// inlining it alone had not helped, the copy stayed).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn clip_incident_edge(

@@ -270,8 +270,8 @@ pub(super) fn collide_polygons_local(
 }
 
 /// [`collide_polygons_local`]'s body, inlined into the polygon pair's hot path
-/// ([`collide_polygons_into`]), whose manifold then stays in registers on its way to the
-/// contact: returned through memory, its normal was read back by a 16-byte load over the
+/// ([`collide_polygons_into`]), whose manifold is then no longer returned through memory on
+/// its way to the contact: returned so, its normal was read back by a 16-byte load over the
 /// narrower stores that made it, which cannot be forwarded (a seventh of the samples of
 /// `collide_polygons_into` in the tumbler).
 #[inline(always)]
