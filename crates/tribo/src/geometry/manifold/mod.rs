@@ -140,10 +140,27 @@ pub(crate) fn collide_bounded(
     speculative_distance: f32,
     last: &Manifold,
 ) -> (Manifold, f32) {
+    let mut m = Manifold::EMPTY;
+    let bound = collide_bounded_into(shape_a, xf_a, shape_b, xf_b, speculative_distance, last, &mut m);
+    (m, bound)
+}
+
+/// [`collide_bounded`] with the manifold written into `out` (the contact's own); returns
+/// the bound. The one dispatch over shape pairs: two polygons write theirs in place (see
+/// [`LocalManifold::write_world`]), the other pairs' manifolds are copied in.
+pub(crate) fn collide_bounded_into(
+    shape_a: &Shape,
+    xf_a: Transform,
+    shape_b: &Shape,
+    xf_b: Transform,
+    speculative_distance: f32,
+    last: &Manifold,
+    out: &mut Manifold,
+) -> f32 {
     let spec = speculative_distance;
     // A chain piece keeps holding a shape it had a manifold with (chain_segment, step 1).
     let held = last.count > 0;
-    match (shape_a, shape_b) {
+    let (m, bound) = match (shape_a, shape_b) {
         (Shape::Circle(a), Shape::Circle(b)) => circle_circle::collide_circles(a, xf_a, b, xf_b, spec),
         (Shape::Circle(a), Shape::Capsule(b)) => flip(capsule_circle::collide_capsule_circle(b, xf_b, a, xf_a, spec)),
         (Shape::Circle(a), Shape::Polygon(b)) => flip(polygon_circle::collide_polygon_circle(b, xf_b, a, xf_a, spec)),
@@ -161,9 +178,7 @@ pub(crate) fn collide_bounded(
         (Shape::Polygon(a), Shape::Circle(b)) => polygon_circle::collide_polygon_circle(a, xf_a, b, xf_b, spec),
         (Shape::Polygon(a), Shape::Capsule(b)) => polygon_capsule::collide_polygon_capsule(a, xf_a, b, xf_b, spec),
         (Shape::Polygon(a), Shape::Polygon(b)) => {
-            let mut m = Manifold::EMPTY;
-            let bound = polygon_polygon::collide_polygons_into(a, xf_a, b, xf_b, spec, last_reference_b(last), &mut m);
-            (m, bound)
+            return polygon_polygon::collide_polygons_into(a, xf_a, b, xf_b, spec, last_reference_b(last), out)
         }
         (Shape::Polygon(a), Shape::Segment(b)) => polygon_segment::collide_polygon_segment(a, xf_a, b, xf_b, spec),
 
@@ -200,33 +215,7 @@ pub(crate) fn collide_bounded(
         (Shape::Segment(_) | Shape::ChainSegment(_), Shape::Segment(_) | Shape::ChainSegment(_)) => {
             (Manifold::EMPTY, 0.0)
         }
-    }
-}
-
-/// [`collide_bounded`] with the manifold written into `out` (the contact's own), in place
-/// for the common pair of two polygons (see [`LocalManifold::write_world`]); returns the
-/// bound.
-pub(crate) fn collide_bounded_into(
-    shape_a: &Shape,
-    xf_a: Transform,
-    shape_b: &Shape,
-    xf_b: Transform,
-    speculative_distance: f32,
-    last: &Manifold,
-    out: &mut Manifold,
-) -> f32 {
-    if let (Shape::Polygon(a), Shape::Polygon(b)) = (shape_a, shape_b) {
-        return polygon_polygon::collide_polygons_into(
-            a,
-            xf_a,
-            b,
-            xf_b,
-            speculative_distance,
-            last_reference_b(last),
-            out,
-        );
-    }
-    let (m, bound) = collide_bounded(shape_a, xf_a, shape_b, xf_b, speculative_distance, last);
+    };
     *out = m;
     bound
 }
