@@ -33,7 +33,9 @@
 //!
 //! [`team_loop`]: ContactSolver::team_loop
 
-use super::contact_wide::{self, StoredContact, WideCold, WideContact, WideDerived, WideHead, COLORS, DYNAMIC_COLORS};
+use super::contact_wide::{
+    self, StoredContact, WideArms, WideCold, WideContact, WideDerived, WideHead, COLORS, DYNAMIC_COLORS,
+};
 use super::wide::{array_of, LANES};
 use crate::collision::contact::{Contact, ContactSums, NO_COLOUR};
 use crate::math::Vec2;
@@ -47,8 +49,8 @@ use crate::solver::contact_solver::{
     ONGOING_ESTIMATE_SWEEPS,
 };
 use crate::solver::{
-    any_load, claim_each, claim_each_share, for_each_chunk_mut4, integrate_positions_range, integrate_velocity_one,
-    BodySim, ConstraintSet, SharedState, StateCell, StateRead, StepContext, TeamProgress,
+    any_load, claim_each, claim_each_share, for_each_chunk_mut, integrate_positions_range, integrate_velocity_one,
+    BodySim, ConstraintSet, SharedState, SliceTuple, StateCell, StateRead, StepContext, TeamProgress,
 };
 use crate::world::Stopwatch;
 
@@ -80,6 +82,8 @@ pub(crate) struct ContactSolver {
     cold: Vec<WideCold>,
     /// Per group: what the passes read ready-made ([`contact_wide::WideDerived::new`]).
     derived: Vec<WideDerived>,
+    /// Per group: its points' anchors (what the warm start, restitution and the store read).
+    arms: Vec<WideArms>,
     /// Constraints that found no colour, whole (solved first in each pass).
     overflow: Vec<ContactConstraint>,
     /// Constraints whose points are all new this step and touching (those the warm-start
@@ -196,7 +200,14 @@ type TeamCuts = Vec<Vec<Vec<usize>>>;
 
 /// A colour's block: its groups (the mutex only hands the claiming thread its `&mut`; it
 /// is never contended).
-type GroupBlock<'a> = TeamBlock<std::sync::Mutex<(&'a mut [WideHead], &'a mut [WideContact], &'a [WideDerived])>>;
+type GroupBlock<'a> = TeamBlock<
+    std::sync::Mutex<(
+        &'a mut [WideHead],
+        &'a [WideArms],
+        &'a mut [WideContact],
+        &'a [WideDerived],
+    )>,
+>;
 
 /// One part of a pass for the substep team: its blocks, thread `k`'s own ones being
 /// `blocks[shares[k] .. shares[k + 1]]` (see `ContactSolver::team_blocks`).
@@ -254,40 +265,23 @@ fn team_bodies_per_thread(bodies: usize, threads: usize) -> usize {
     bodies.div_ceil(threads).max(1)
 }
 
-/// The four group arrays cut into `chunks` (ranges of groups in ascending order, each
-/// with the thread that takes it; [`ContactSolver::build_shares`]), thread by thread, each
-/// chunk with the index of its first group. Groups outside every chunk are left out.
-#[allow(clippy::type_complexity)]
-fn split_shares<'a>(
-    arrays: (
-        &'a mut [WideHead],
-        &'a mut [WideContact],
-        &'a mut [WideCold],
-        &'a mut [WideDerived],
-    ),
-    chunks: &BuildChunks,
-    threads: usize,
-) -> Vec<Vec<(usize, GroupChunk<'a>)>> {
-    let mut out: Vec<Vec<(usize, GroupChunk<'a>)>> = (0..threads).map(|_| Vec::new()).collect();
-    let (mut h, mut w, mut c, mut d) = arrays;
+/// The group arrays cut into `chunks` (ranges of groups in ascending order, each with the
+/// thread that takes it; [`ContactSolver::build_shares`]), thread by thread, each chunk
+/// with the index of its first group. Groups outside every chunk are left out.
+fn split_shares<S: SliceTuple>(arrays: S, chunks: &BuildChunks, threads: usize) -> Vec<Vec<(usize, S)>> {
+    let mut out: Vec<Vec<(usize, S)>> = (0..threads).map(|_| Vec::new()).collect();
+    let mut rest = arrays;
     let mut taken = 0usize;
     for (r, k) in chunks {
         let (a, b) = (r.start, r.end);
-        if a < taken || b < a || b > taken + h.len() {
+        if a < taken || b < a || b > taken + rest.len() {
             continue; // not ascending, or out of range: not a cut of these arrays
         }
-        let (skip, len) = (a - taken, b - a);
-        let (_, h_rest) = core::mem::take(&mut h).split_at_mut(skip);
-        let (_, w_rest) = core::mem::take(&mut w).split_at_mut(skip);
-        let (_, c_rest) = core::mem::take(&mut c).split_at_mut(skip);
-        let (_, d_rest) = core::mem::take(&mut d).split_at_mut(skip);
-        let (hs, h_rest) = h_rest.split_at_mut(len);
-        let (ws, w_rest) = w_rest.split_at_mut(len);
-        let (cs, c_rest) = c_rest.split_at_mut(len);
-        let (ds, d_rest) = d_rest.split_at_mut(len);
-        (h, w, c, d, taken) = (h_rest, w_rest, c_rest, d_rest, b);
+        let (_, from_a) = rest.split_at(a - taken);
+        let (chunk, after) = from_a.split_at(b - a);
+        (rest, taken) = (after, b);
         if let Some(share) = out.get_mut(*k) {
-            share.push((a, (hs, ws, cs, ds)));
+            share.push((a, chunk));
         }
     }
     out
@@ -297,9 +291,10 @@ fn split_shares<'a>(
 /// ([`ContactSolver::build_shares`]).
 type BuildChunks = Vec<(core::ops::Range<usize>, usize)>;
 
-/// A run of groups' four arrays.
+/// A run of groups' five arrays.
 type GroupChunk<'a> = (
     &'a mut [WideHead],
+    &'a mut [WideArms],
     &'a mut [WideContact],
     &'a mut [WideCold],
     &'a mut [WideDerived],
@@ -409,11 +404,7 @@ impl ContactSolver {
         // each thread builds the groups it will solve (see `build_shares`).
         let shares = self.build_shares(ctx, sims.len());
         let lane_candidates = &self.lane_candidates;
-        let build_chunk = |first: usize,
-                           heads: &mut [WideHead],
-                           wides: &mut [WideContact],
-                           colds: &mut [WideCold],
-                           derived: &mut [WideDerived]| {
+        let build_chunk = |first: usize, (heads, arms, wides, colds, derived): GroupChunk<'_>| {
             for k in 0..heads.len() {
                 let g = first + k;
                 if let Some(ahead) = lane_candidates.get(g + PREFETCH_GROUPS) {
@@ -436,20 +427,28 @@ impl ContactSolver {
                     crate::solver::prefetch(c);
                     crate::solver::prefetch(d);
                 }
+                if let Some(r) = arms.get(k + PREFETCH_GROUPS) {
+                    crate::solver::prefetch(r);
+                }
                 let lanes = array_of(|l| {
                     candidates
                         .get(lane_candidates[g][l] as usize)
                         .map(|cand| (cand.contact, &cand.input, &cand.bodies))
                 });
-                if let (Some(h), Some(w), Some(cold), Some(dv)) =
-                    (heads.get_mut(k), wides.get_mut(k), colds.get_mut(k), derived.get_mut(k))
-                {
-                    contact_wide::build_group(h, w, cold, dv, lanes, up, ctx, states);
+                if let (Some(h), Some(r), Some(w), Some(cold), Some(dv)) = (
+                    heads.get_mut(k),
+                    arms.get_mut(k),
+                    wides.get_mut(k),
+                    colds.get_mut(k),
+                    derived.get_mut(k),
+                ) {
+                    contact_wide::build_group(h, r, w, cold, dv, lanes, up, ctx, states);
                 }
             }
         };
         let arrays = (
             &mut self.head[..],
+            &mut self.arms[..],
             &mut self.wide[..],
             &mut self.cold[..],
             &mut self.derived[..],
@@ -458,9 +457,9 @@ impl ContactSolver {
             Some((chunks, threads)) => {
                 self.shared_builds += 1;
                 let items = split_shares(arrays, &chunks, threads);
-                claim_each_share(true, items, |(first, (h, w, c, d))| build_chunk(first, h, w, c, d));
+                claim_each_share(true, items, |(first, chunk)| build_chunk(first, chunk));
             }
-            None => for_each_chunk_mut4(ctx.parallel, arrays, GROUP_CHUNK, build_chunk),
+            None => for_each_chunk_mut(ctx.parallel, arrays, GROUP_CHUNK, build_chunk),
         }
         self.loaded = loaded;
         if self.loaded {
@@ -596,6 +595,8 @@ impl ContactSolver {
         self.cold.truncate(groups as usize);
         self.derived.resize(groups as usize, WideDerived::default());
         self.derived.truncate(groups as usize);
+        self.arms.resize(groups as usize, WideArms::default());
+        self.arms.truncate(groups as usize);
         // 3. Slots: overflow constraints are built here, coloured ones below.
         let soft = self.soft;
         // Locals again for the loop (see step 1).
@@ -843,7 +844,14 @@ impl ContactSolver {
         match slot {
             Slot::Wide { group, lane } => {
                 let g = group as usize;
-                contact_wide::unpack_full(&self.head[g], &self.wide[g], &self.cold[g], &self.soft, lane as usize)
+                contact_wide::unpack_full(
+                    &self.head[g],
+                    &self.arms[g],
+                    &self.wide[g],
+                    &self.cold[g],
+                    &self.soft,
+                    lane as usize,
+                )
             }
             Slot::Overflow(i) => self.overflow[i as usize],
         }
@@ -861,7 +869,8 @@ impl ContactSolver {
                     let (da, db) = (h.write_a[lane as usize], h.write_b[lane as usize]);
                     // (The lane's geometry comes back as it was unpacked, so the group's
                     // derived part is made again with the same bits.)
-                    contact_wide::pack(h, w, &mut self.cold[g], &mut self.derived[g], lane as usize, cc, da, db);
+                    let (arms, cold, dv) = (&mut self.arms[g], &mut self.cold[g], &mut self.derived[g]);
+                    contact_wide::pack(h, arms, w, cold, dv, lane as usize, cc, da, db);
                 } else {
                     contact_wide::pack_state(h, w, lane as usize, cc);
                 }
@@ -986,7 +995,9 @@ impl ContactSolver {
     ) {
         let at = |contact: u32| (contact as usize).wrapping_sub(base);
         for g in range.clone() {
-            let (Some(h), Some(w), Some(cold)) = (self.head.get(g), self.wide.get(g), self.cold.get(g)) else {
+            let (Some(h), Some(arms), Some(w), Some(cold)) =
+                (self.head.get(g), self.arms.get(g), self.wide.get(g), self.cold.get(g))
+            else {
                 continue;
             };
             if let (Some(ahead), Some(ahead_cold)) = (
@@ -1008,7 +1019,7 @@ impl ContactSolver {
                     }
                 }
             }
-            let out = contact_wide::store_group(h, w, cold, states, ctx);
+            let out = contact_wide::store_group(h, arms, w, cold, states, ctx);
             let (Some(lanes), Some(&colour)) = (self.lane_candidates.get(g), self.group_colour.get(g)) else {
                 continue;
             };
@@ -1075,8 +1086,11 @@ impl ContactSolver {
         }
         for &(start, end) in &self.ranges {
             let colour = &mut self.head[start as usize..end as usize];
-            S::for_each_mut(states, colour, GROUP_CHUNK, |_, h, states| {
-                contact_wide::warm_start(h, states)
+            let arms = &self.arms[start as usize..end as usize];
+            S::for_each_mut(states, colour, GROUP_CHUNK, |i, h, states| {
+                if let Some(r) = arms.get(i) {
+                    contact_wide::warm_start(h, r, states)
+                }
             });
         }
     }
@@ -1151,12 +1165,13 @@ impl ContactSolver {
         let groups = self
             .head
             .iter_mut()
+            .zip(&self.arms)
             .zip(self.wide.iter_mut())
             .zip(&self.derived)
             .zip(&self.cold);
-        for (((h, w), dv), cold) in groups {
+        for ((((h, arms), w), dv), cold) in groups {
             if cold.any_restitution {
-                contact_wide::restitution(h, w, dv, cold, states);
+                contact_wide::restitution(h, arms, w, dv, cold, states);
             }
         }
     }
@@ -1239,13 +1254,19 @@ impl ContactSolver {
             let mut lap = Stopwatch::start();
             let mut t = [0.0f32; 5];
             let mut at = TeamCursor::default();
-            let each_colour = |at: &mut TeamCursor, f: &dyn Fn(&mut WideHead, &mut WideContact, &WideDerived)| {
+            type Pass<'p> = &'p dyn Fn(&mut WideHead, &WideArms, &mut WideContact, &WideDerived);
+            let each_colour = |at: &mut TeamCursor, f: Pass<'_>| {
                 for parts in &colours {
                     team_pass(parts, k, at, &progress, |part| {
                         let mut guard = part.lock().unwrap_or_else(|e| e.into_inner());
-                        let (heads, wides, derived) = &mut *guard;
-                        for ((h, w), dv) in heads.iter_mut().zip(wides.iter_mut()).zip(derived.iter()) {
-                            f(h, w, dv);
+                        let (heads, arms, wides, derived) = &mut *guard;
+                        let groups = heads
+                            .iter_mut()
+                            .zip(arms.iter())
+                            .zip(wides.iter_mut())
+                            .zip(derived.iter());
+                        for (((h, r), w), dv) in groups {
+                            f(h, r, w, dv);
                         }
                     });
                 }
@@ -1258,9 +1279,9 @@ impl ContactSolver {
                     }
                 });
                 t[0] += lap.lap();
-                each_colour(&mut at, &|h, _, _| contact_wide::warm_start(h, states));
+                each_colour(&mut at, &|h, r, _, _| contact_wide::warm_start(h, r, states));
                 t[1] += lap.lap();
-                each_colour(&mut at, &|h, w, dv| {
+                each_colour(&mut at, &|h, _, w, dv| {
                     contact_wide::solve::<true, SharedState>(h, w, dv, states, ctx, &soft, elapsed)
                 });
                 t[2] += lap.lap();
@@ -1268,7 +1289,7 @@ impl ContactSolver {
                     integrate_positions_range(ctx, sims, states, range.clone());
                 });
                 t[3] += lap.lap();
-                each_colour(&mut at, &|h, w, dv| {
+                each_colour(&mut at, &|h, _, w, dv| {
                     contact_wide::solve::<false, SharedState>(h, w, dv, states, ctx, &soft, elapsed + ctx.h)
                 });
                 t[4] += lap.lap();
@@ -1451,6 +1472,7 @@ impl ContactSolver {
         };
         let (mut heads, mut wides): (&mut [WideHead], &mut [WideContact]) = (&mut self.head, &mut self.wide);
         let mut derived: &[WideDerived] = &self.derived;
+        let mut arms: &[WideArms] = &self.arms;
         let mut taken = 0usize;
         let mut colours = Vec::with_capacity(cuts.len());
         for parts in &cuts {
@@ -1459,7 +1481,8 @@ impl ContactSolver {
                 let (_, h_rest) = core::mem::take(&mut heads).split_at_mut(at[0] - taken);
                 let (_, w_rest) = core::mem::take(&mut wides).split_at_mut(at[0] - taken);
                 let (_, d_rest) = derived.split_at(at[0] - taken);
-                (heads, wides, derived, taken) = (h_rest, w_rest, d_rest, at[0]);
+                let (_, r_rest) = arms.split_at(at[0] - taken);
+                (heads, wides, derived, arms, taken) = (h_rest, w_rest, d_rest, r_rest, at[0]);
                 let mut part = TeamPart {
                     blocks: Vec::new(),
                     shares: Vec::with_capacity(threads + 1),
@@ -1470,13 +1493,16 @@ impl ContactSolver {
                     let (h, h_rest) = core::mem::take(&mut heads).split_at_mut(len);
                     let (w, w_rest) = core::mem::take(&mut wides).split_at_mut(len);
                     let (d, d_rest) = derived.split_at(len);
-                    (heads, wides, derived, taken) = (h_rest, w_rest, d_rest, at[k + 1]);
+                    let (r, r_rest) = arms.split_at(len);
+                    (heads, wides, derived, arms, taken) = (h_rest, w_rest, d_rest, r_rest, at[k + 1]);
                     let blocks = h
                         .chunks_mut(TEAM_BLOCK)
+                        .zip(r.chunks(TEAM_BLOCK))
                         .zip(w.chunks_mut(TEAM_BLOCK))
                         .zip(d.chunks(TEAM_BLOCK));
-                    for ((hs, ws), ds) in blocks {
-                        part.blocks.push(TeamBlock::new(std::sync::Mutex::new((hs, ws, ds))));
+                    for (((hs, rs), ws), ds) in blocks {
+                        part.blocks
+                            .push(TeamBlock::new(std::sync::Mutex::new((hs, rs, ws, ds))));
                     }
                 }
                 part.shares.push(part.blocks.len());
@@ -1621,7 +1647,7 @@ mod tests {
             .flat_map(|k| shares[k].iter().map(move |r| (r.clone(), k)))
             .collect();
         chunks.sort_unstable_by_key(|(r, _)| r.start);
-        let out = split_shares((&mut h, &mut w, &mut c, &mut d), &chunks, 2);
+        let out = split_shares((&mut h[..], &mut w[..], &mut c[..], &mut d[..]), &chunks, 2);
         let mut owner = vec![None; n];
         for (k, chunks) in out.iter().enumerate() {
             for (first, (hs, ws, cs, ds)) in chunks {

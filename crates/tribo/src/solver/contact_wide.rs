@@ -62,11 +62,10 @@ pub(crate) struct WidePoint {
     pub approach: FL,
 }
 
-/// One point of four constraints: what the warm start reads and writes.
+/// One point of four constraints: what the warm start reads and writes and the solve
+/// passes read too (its anchors are in [`WideArms`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct HeadPoint {
-    pub r_a: VL,
-    pub r_b: VL,
     pub normal_impulse: FL,
     /// `ConstraintPoint::substep_vn`, recorded only in groups with restitution
     /// ([`WideHead::any_restitution`]).
@@ -106,6 +105,26 @@ pub(crate) struct WideHead {
     /// point reports half its impulse (one point: the whole).
     pub two_points: ML,
     pub rolling_impulse: FL,
+}
+
+/// One point's anchors in four constraints, from the bodies' centres at the step start
+/// (r_a, r_b) [m].
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct PointArms {
+    pub r_a: VL,
+    pub r_b: VL,
+}
+
+/// The points' anchors of four constraints: what the warm start, restitution and the
+/// store read, but not the solve passes (they read the anchors' moments in
+/// [`WideDerived`]). In an array of their own, not in [`WideHead`]: the solve and relax
+/// passes stream their groups from beyond the L2 cache in large scenes (large_pyramid's
+/// 1 873 groups are 3.6 MB), and lines they do not read but that lie among those they do
+/// are streamed as well (256 unread bytes added to each [`WideContact`] made
+/// large_pyramid's solve and relax 9–10 % slower). Written by the build and [`pack`] only.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct WideArms {
+    pub points: [PointArms; 2],
 }
 
 /// The rest of four contact constraints, one per lane (see the module docs): what only
@@ -187,13 +206,13 @@ impl WideDerived {
     /// anchors and normal (in `h`) and its K and 1/det K: the expressions the passes
     /// evaluated each time, so the same bits.
     #[inline(always)]
-    fn new(friction: (VL, VL), t: VL, h: &WideHead, w: &WideContact) -> WideDerived {
+    fn new(friction: (VL, VL), t: VL, h: &WideHead, arms: &WideArms, w: &WideContact) -> WideDerived {
         WideDerived {
             fr_moments: moments(friction, t),
             // Spelled out, not `map`ped (see `point_impulse`).
             normal_moments: [
-                moments((h.points[0].r_a, h.points[0].r_b), h.normal),
-                moments((h.points[1].r_a, h.points[1].r_b), h.normal),
+                moments((arms.points[0].r_a, arms.points[0].r_b), h.normal),
+                moments((arms.points[1].r_a, arms.points[1].r_b), h.normal),
             ],
             i11: w.k22 * w.inv_det,
             i12: -w.k12 * w.inv_det,
@@ -207,7 +226,8 @@ impl WideDerived {
 const VECTOR: usize = core::mem::size_of::<FL>();
 const _: () = assert!(core::mem::size_of::<WideDerived>() == 9 * VECTOR);
 const _: () = assert!(core::mem::size_of::<WideContact>() == 25 * VECTOR);
-const _: () = assert!(core::mem::size_of::<WideHead>() == 26 * VECTOR);
+const _: () = assert!(core::mem::size_of::<WideHead>() == 18 * VECTOR);
+const _: () = assert!(core::mem::size_of::<WideArms>() == 8 * VECTOR);
 
 /// Four bodies' velocities and step motion, gathered from `BodyState`s.
 #[derive(Clone, Copy, Debug)]
@@ -371,8 +391,8 @@ fn apply_row(c: &WideHead, a: &mut WideBody, b: &mut WideBody, u: VL, m: (FL, FL
 /// The friction row's anchors: the middle of a two-point patch, else the single point
 /// (`contact_solver::build_constraint`'s patch row; the same expression).
 #[inline(always)]
-fn friction_arms(h: &WideHead) -> (VL, VL) {
-    let [p0, p1] = &h.points;
+fn friction_arms(h: &WideHead, arms: &WideArms) -> (VL, VL) {
+    let [p0, p1] = &arms.points;
     (
         patch_anchor(h.two_points, p0.r_a, p1.r_a),
         patch_anchor(h.two_points, p0.r_b, p1.r_b),
@@ -436,7 +456,7 @@ fn point_impulse(c: &WideHead, n: VL, t: VL, i: usize) -> VL {
 /// speed; the only reader, so a group without restitution skips it: large_pyramid's warm
 /// start went from 0.305 to 0.279 ms per step).
 #[super::lane_inline]
-pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
+pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, arms: &WideArms, states: &[S]) {
     let n = c.normal;
     let t = n.right_perp();
     // Both points' impulses P_i = λn_i n + λt_i t at once: the bodies take their sum P and
@@ -448,14 +468,15 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
     // (warm start −6 % in large_pyramid and tumbler, the same instructions).
     let (p0, p1) = (point_impulse(c, n, t, 0), point_impulse(c, n, t, 1));
     let total = p0 + p1;
-    let arms_a = c.points[0].r_a.cross(p0) + c.points[1].r_a.cross(p1);
-    let arms_b = c.points[0].r_b.cross(p0) + c.points[1].r_b.cross(p1);
+    let [r0, r1] = &arms.points;
+    let arms_a = r0.r_a.cross(p0) + r1.r_a.cross(p1);
+    let arms_b = r0.r_b.cross(p0) + r1.r_b.cross(p1);
     let mut a = gather(states, &c.index_a);
     let mut b = gather(states, &c.index_b);
     let shift = capped_shift(c, b.dp - a.dp);
     if c.any_restitution {
         for i in 0..2 {
-            let p = &c.points[i];
+            let p = &arms.points[i];
             let (r_a, r_b) = lever_arms(c, shift, p.r_a, p.r_b);
             c.points[i].substep_vn = relative_velocity(&a, &b, r_a, r_b).dot(n);
         }
@@ -485,6 +506,7 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, states: &[S]) {
 #[super::lane_fn]
 pub(crate) fn restitution<S: StateCell>(
     h: &mut WideHead,
+    anchors: &WideArms,
     w: &mut WideContact,
     dv: &WideDerived,
     cold: &WideCold,
@@ -508,7 +530,7 @@ pub(crate) fn restitution<S: StateCell>(
     let mut b = gather(states, &h.index_b);
     // The bodies' displacements do not change here: nor do the lever arms.
     let shift = capped_shift(h, b.dp - a.dp);
-    let arms: [(VL, VL); 2] = array_of(|i| lever_arms(h, shift, h.points[i].r_a, h.points[i].r_b));
+    let arms: [(VL, VL); 2] = array_of(|i| lever_arms(h, shift, anchors.points[i].r_a, anchors.points[i].r_b));
     let n = h.normal;
     let normal_velocity = |a: &WideBody, b: &WideBody, i: usize| relative_velocity(a, b, arms[i].0, arms[i].1).dot(n);
     // Point `i` takes the impulse `new` in the lanes of `m` (elsewhere not even a zero's
@@ -864,6 +886,7 @@ pub(crate) type LaneInput<'a> = Option<(u32, &'a ContactInput, &'a ConstraintBod
 #[super::lane_fn]
 pub(crate) fn build_group<S: StateRead>(
     head: &mut WideHead,
+    anchors: &mut WideArms,
     w: &mut WideContact,
     cold: &mut WideCold,
     derived: &mut WideDerived,
@@ -1053,8 +1076,7 @@ pub(crate) fn build_group<S: StateRead>(
         let (r_a, r_b) = (keep(point[i] - center_a), keep(point[i] - center_b));
         arms[i] = (r_a, r_b);
         kn[i] = k_of(r_a, r_b, n);
-        hd.points[i].r_a = r_a;
-        hd.points[i].r_b = r_b;
+        anchors.points[i] = PointArms { r_a, r_b };
         let wp = &mut out.points[i];
         wp.normal_mass = has[i].select(inv_or_zero(kn[i]), zero);
     }
@@ -1062,7 +1084,7 @@ pub(crate) fn build_group<S: StateRead>(
     let two = has[1];
     hd.two_points = two;
     // Friction row: the patch middle of two points, or the single point.
-    let (fr_a, fr_b) = friction_arms(hd);
+    let (fr_a, fr_b) = friction_arms(hd, anchors);
     out.tangent_mass = has[0].select(inv_or_zero(k_of(fr_a, fr_b, t)), zero);
     let [d0, d1] = base_drift;
     out.base_drift = two.select(half * (d0 + d1), d0);
@@ -1079,7 +1101,7 @@ pub(crate) fn build_group<S: StateRead>(
     out.k12 = block.select(k12, zero);
     out.k22 = block.select(k22, zero);
     out.inv_det = block.select(inv, zero);
-    *derived = WideDerived::new((fr_a, fr_b), t, hd, out);
+    *derived = WideDerived::new((fr_a, fr_b), t, hd, anchors, out);
 }
 
 /// `contact_solver::shift_cap2` four lanes at once (the same quotients and minimum; the
@@ -1145,6 +1167,7 @@ fn write_stored(
 #[super::lane_fn]
 pub(crate) fn store_group<S: StateRead>(
     h: &WideHead,
+    arms: &WideArms,
     w: &WideContact,
     cold: &WideCold,
     states: &[S],
@@ -1160,7 +1183,7 @@ pub(crate) fn store_group<S: StateRead>(
     let mut vt = [FL::ZERO; 2];
     let mut disp = [FL::ZERO; 2];
     for i in 0..2 {
-        let p = &h.points[i];
+        let p = &arms.points[i];
         let (m, along) = frame.point(&a, &b, p.r_a, p.r_b);
         (vt[i], disp[i]) = (row_speed(&a, &b, t, m) - w.tangent_speed, along);
     }
@@ -1336,6 +1359,7 @@ impl StoredGroup {
 #[super::lane_fn]
 pub(crate) fn pack(
     h: &mut WideHead,
+    arms: &mut WideArms,
     w: &mut WideContact,
     cold: &mut WideCold,
     derived: &mut WideDerived,
@@ -1376,7 +1400,7 @@ pub(crate) fn pack(
     w.rolling_resistance[l] = cc.rolling_resistance;
     h.any_rolling |= cc.rolling_resistance > 0.0 || cc.rolling_impulse != 0.0;
     for i in 0..2 {
-        let (hp, wp) = (&mut h.points[i], &mut w.points[i]);
+        let (hp, wp) = (&mut arms.points[i], &mut w.points[i]);
         if i < cc.count {
             let cp = &cc.points[i];
             hp.r_a.x[l] = cp.r_a.x;
@@ -1426,7 +1450,7 @@ pub(crate) fn pack(
     w.mu[l] = if stick { cc.mu_s } else { cc.mu_d };
     h.two_points[l] = if cc.count == 2 { u32::MAX } else { 0 };
     pack_state(h, w, l, cc);
-    *derived = WideDerived::new(friction_arms(h), h.normal.right_perp(), h, w);
+    *derived = WideDerived::new(friction_arms(h, arms), h.normal.right_perp(), h, arms, w);
 }
 
 /// Copies the parts of a constraint that change during the substeps into lane `l`.
@@ -1486,6 +1510,7 @@ pub(crate) fn unpack_state(h: &WideHead, w: &WideContact, l: usize, cc: &mut Con
 #[super::lane_fn]
 pub(crate) fn unpack_full(
     h: &WideHead,
+    arms: &WideArms,
     w: &WideContact,
     cold: &WideCold,
     soft: &StepSoftness,
@@ -1534,7 +1559,7 @@ pub(crate) fn unpack_full(
     for i in 0..count {
         let wp = &w.points[i];
         let cp = &mut cc.points[i];
-        let hp = &h.points[i];
+        let hp = &arms.points[i];
         cp.r_a = Vec2::new(hp.r_a.x[l], hp.r_a.y[l]);
         cp.r_b = Vec2::new(hp.r_b.x[l], hp.r_b.y[l]);
         cp.base_separation = wp.base_separation[l];
@@ -1576,10 +1601,12 @@ mod tests {
         up: Vec2,
         ctx: &StepContext,
         states: &[S],
-    ) -> (WideHead, WideContact, WideCold, WideDerived) {
-        let (mut h, mut w, mut cold, mut dv) = Default::default();
-        lane_call!(build_group(&mut h, &mut w, &mut cold, &mut dv, lanes, up, ctx, states));
-        (h, w, cold, dv)
+    ) -> (WideHead, WideArms, WideContact, WideCold, WideDerived) {
+        let (mut h, mut arms, mut w, mut cold, mut dv) = Default::default();
+        lane_call!(build_group(
+            &mut h, &mut arms, &mut w, &mut cold, &mut dv, lanes, up, ctx, states
+        ));
+        (h, arms, w, cold, dv)
     }
 
     fn input(count: usize, fresh: bool, restitution: f32, rolling: f32) -> ContactInput {
@@ -1700,12 +1727,12 @@ mod tests {
     fn built_as_packed(
         f: &Fixture,
         cases: &[(u32, ContactInput, ConstraintBodies)],
-    ) -> (WideHead, WideContact, WideCold, WideDerived) {
+    ) -> (WideHead, WideArms, WideContact, WideCold, WideDerived) {
         let (ctx, soft, states, up) = (f.ctx, f.soft, &f.states, f.up);
-        let (h, w, cold, dv) = built(lanes_of(cases), up, &ctx, states);
+        let (h, arms, w, cold, dv) = built(lanes_of(cases), up, &ctx, states);
         // Packed lane by lane over a copy whose ready-made part is spoilt first: pack must
         // make it again.
-        let (mut rh, mut r, mut rcold) = (h, w, cold);
+        let (mut rh, mut rarms, mut r, mut rcold) = (h, arms, w, cold);
         let mut rdv = WideDerived {
             i12: FL::splat(7.0),
             normal_moments: [(FL::splat(7.0), FL::splat(7.0)); 2],
@@ -1716,6 +1743,7 @@ mod tests {
             let dyn_side = |m: f32, i: f32| m > 0.0 || i > 0.0;
             lane_call!(pack(
                 &mut rh,
+                &mut rarms,
                 &mut r,
                 &mut rcold,
                 &mut rdv,
@@ -1726,17 +1754,18 @@ mod tests {
             ));
         }
         assert_eq!(format!("{h:?}"), format!("{rh:?}"));
+        assert_eq!(format!("{arms:?}"), format!("{rarms:?}"));
         assert_eq!(format!("{w:?}"), format!("{r:?}"));
         assert_eq!(format!("{cold:?}"), format!("{rcold:?}"));
         assert_eq!(format!("{dv:?}"), format!("{rdv:?}"));
-        (h, w, cold, dv)
+        (h, arms, w, cold, dv)
     }
 
     #[test]
     fn wide_build_equals_scalar_build_and_pack() {
         let f = fixture();
         let (ctx, soft, states, up, cases) = (f.ctx, f.soft, &f.states, f.up, &f.cases);
-        let (h, w, cold, dv) = built_as_packed(&f, cases);
+        let (h, arms, w, cold, dv) = built_as_packed(&f, cases);
         // The ready-made part, lane by lane from the scalar build: the moments of the
         // friction row's anchors, at the middle of two points (at the point of one), K⁻¹
         // from the block's K and 1/det K (zeros, the middle one −0, where the block does
@@ -1766,7 +1795,7 @@ mod tests {
         // coefficient) comes back as the scalar build made it.
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
             let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
-            let u = lane_call!(unpack_full(&h, &w, &cold, &soft, l));
+            let u = lane_call!(unpack_full(&h, &arms, &w, &cold, &soft, l));
             let derived = |c: &ContactConstraint| {
                 let soft: Vec<_> = c.points[..c.count].iter().map(|p| p.soft).collect();
                 format!("{:?}", (c.mu_s, c.mu_d, c.rolling_mass, c.k, c.inv_det, c.block, soft))
@@ -1800,8 +1829,8 @@ mod tests {
             w.base_drift,
         ];
         for i in 0..2 {
-            let (hp, wp) = (&h.points[i], &w.points[i]);
-            empty.extend([hp.r_a.x, hp.r_a.y, hp.r_b.x, hp.r_b.y, hp.normal_impulse]);
+            let (hp, ap, wp) = (&h.points[i], &arms.points[i], &w.points[i]);
+            empty.extend([ap.r_a.x, ap.r_a.y, ap.r_b.x, ap.r_b.y, hp.normal_impulse]);
             empty.extend([wp.base_separation, wp.normal_mass, wp.preload]);
         }
         let cold_lane = [cold.mu_s[3], cold.mu_d[3], cold.restitution[3], cold.height[3]];
@@ -1812,14 +1841,12 @@ mod tests {
     /// A group whose every field holds a value (`k` = 0 or 1: two different ones, the
     /// booleans both ways) that the build must overwrite. A full literal, no `..`: a field
     /// added to either record does not compile here until it is poisoned too.
-    fn poisoned(k: usize) -> (WideHead, WideContact) {
+    fn poisoned(k: usize) -> (WideHead, WideArms, WideContact) {
         let (x, flag, index) = ([7.5, -7.5][k], k == 0, [7, 9][k]);
         let x = FL::splat(x);
         let v = VL { x, y: x };
         let m = ML::new([[0x0101_0101, u32::MAX][k]; LANES]);
         let hp = HeadPoint {
-            r_a: v,
-            r_b: v,
             normal_impulse: x,
             substep_vn: x,
         };
@@ -1866,7 +1893,10 @@ mod tests {
             total_tangent_impulse: x,
             saturated: m,
         };
-        (head, w)
+        let arms = WideArms {
+            points: [PointArms { r_a: v, r_b: v }; 2],
+        };
+        (head, arms, w)
     }
 
     /// The build against the scalar build and pack where no point is new (a resting pile's
@@ -1887,7 +1917,7 @@ mod tests {
             (9, one, static_with_mass),
             (12, input(2, false, 0.4, 0.05), bodies(2, 1)),
         ];
-        let (h, _, cold, _) = built_as_packed(&f, &cases);
+        let (h, _, _, cold, _) = built_as_packed(&f, &cases);
         // What the cases claim: no point is new; the first point of each lane sticks (it
         // lies at x > 0), the second of a two-point lane slides, the one-point lane's
         // absent point neither; lane 1's side A is not written back, its side B is.
@@ -1911,10 +1941,11 @@ mod tests {
                 ..f.ctx
             };
             let clean = built(f.lanes(), f.up, &ctx, &f.states);
-            let (_, _, mut cold, mut dv) = clean;
-            let (mut h, mut w) = poisoned(k);
+            let (_, _, _, mut cold, mut dv) = clean;
+            let (mut h, mut arms, mut w) = poisoned(k);
             lane_call!(build_group(
                 &mut h,
+                &mut arms,
                 &mut w,
                 &mut cold,
                 &mut dv,
@@ -1924,8 +1955,8 @@ mod tests {
                 &f.states
             ));
             assert_eq!(
-                format!("{:?}", (clean.0, clean.1)),
-                format!("{:?}", (h, w)),
+                format!("{:?}", (clean.0, clean.1, clean.2)),
+                format!("{:?}", (h, arms, w)),
                 "warm {warm}, poison {k}"
             );
         }
@@ -1956,7 +1987,7 @@ mod tests {
         ] {
             let mut lanes: [LaneInput<'_>; LANES] = [None; LANES];
             lanes[lane] = Some((id, input, b));
-            let (h, _, cold, _) = built(lanes, f.up, &f.ctx, &f.states);
+            let (h, _, _, cold, _) = built(lanes, f.up, &f.ctx, &f.states);
             assert_eq!((h.any_restitution, h.any_rolling), expected, "lane {lane}");
             assert_eq!(cold.any_restitution, expected.0);
             let height = input.points[0].point.dot(f.up);
@@ -2005,12 +2036,12 @@ mod tests {
             (11, input(points, false, 0.0, 0.0), bodies(6, 7)),
         ];
         let lanes: [LaneInput<'_>; LANES] = core::array::from_fn(|l| cases.get(l).map(|c| (c.0, &c.1, &c.2)));
-        let (mut h, mut w, cold, dv) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
+        let (mut h, arms, mut w, cold, dv) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
         let d = states[7].dp - states[6].dp;
         assert!(d.length_squared() > h.shift_cap2[3], "lane 3's shift is capped");
         let built = (h, w);
         let mut scalar: Vec<ContactConstraint> = (0..cases.len())
-            .map(|l| lane_call!(unpack_full(&h, &w, &cold, &soft, l)))
+            .map(|l| lane_call!(unpack_full(&h, &arms, &w, &cold, &soft, l)))
             .collect();
         let cells = |s: &[BodyState]| -> Vec<core::cell::Cell<BodyState>> {
             s.iter().map(|&s| core::cell::Cell::new(s)).collect()
@@ -2028,7 +2059,7 @@ mod tests {
                 crate::solver::contact_solver::solve_one(cc, &scalar_states, &ctx, bias, elapsed);
             }
             for (l, cc) in scalar.iter().enumerate() {
-                let lane = lane_call!(unpack_full(&h, &w, &cold, &soft, l));
+                let lane = lane_call!(unpack_full(&h, &arms, &w, &cold, &soft, l));
                 for (i, (p, q)) in cc.points.iter().zip(&lane.points).enumerate().take(points) {
                     let bits = |p: &ConstraintPoint| (p.normal_impulse.to_bits(), p.tangent_impulse.to_bits());
                     if tol == 0.0 {
@@ -2121,10 +2152,10 @@ mod tests {
         let face = (6u32, input(2, false, 0.0, 0.05), bodies(3, 4));
         // Warm start, biased and relax passes; then lane 0's impulses and its two bodies.
         let run = |cases: &[(u32, ContactInput, ConstraintBodies)]| {
-            let (mut h, mut w, _, dv) = built(lanes_of(cases), Vec2::new(0.0, 1.0), &ctx, &states);
+            let (mut h, arms, mut w, _, dv) = built(lanes_of(cases), Vec2::new(0.0, 1.0), &ctx, &states);
             let (two, rolling) = (h.two_points.any(), h.any_rolling);
             let cells: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
-            warm_start(&mut h, &cells);
+            warm_start(&mut h, &arms, &cells);
             solve::<true, _>(&mut h, &mut w, &dv, &cells, &ctx, &soft, ctx.h);
             solve::<false, _>(&mut h, &mut w, &dv, &cells, &ctx, &soft, ctx.h);
             // Through `Debug`, which tells −0.0 from +0.0.
@@ -2159,7 +2190,7 @@ mod tests {
     #[test]
     fn wide_store_equals_scalar_store() {
         let f = fixture();
-        let (mut h, mut w, cold, dv) = built(f.lanes(), f.up, &f.ctx, &f.states);
+        let (mut h, arms, mut w, cold, dv) = built(f.lanes(), f.up, &f.ctx, &f.states);
         let cells: Vec<core::cell::Cell<BodyState>> = f.states.iter().map(|&s| core::cell::Cell::new(s)).collect();
         solve::<false, _>(&mut h, &mut w, &dv, &cells, &f.ctx, &f.soft, f.ctx.h);
         let moved: Vec<BodyState> = cells
@@ -2171,11 +2202,11 @@ mod tests {
                 s
             })
             .collect();
-        let stored = lane_call!(store_group(&h, &w, &cold, &moved, &f.ctx));
+        let stored = lane_call!(store_group(&h, &arms, &w, &cold, &moved, &f.ctx));
         let out: [StoredContact; LANES] = core::array::from_fn(|l| lane_call!(stored.lane(l)));
         let (mut slipped, mut pushed) = (false, false);
         for l in 0..3 {
-            let cc = lane_call!(unpack_full(&h, &w, &cold, &f.soft, l));
+            let cc = lane_call!(unpack_full(&h, &arms, &w, &cold, &f.soft, l));
             let mut c = crate::collision::contact::blank_contact();
             let mut sums = ContactSums::default();
             store_impulses(&cc, &mut c, &mut sums, &moved, &f.ctx);
@@ -2247,7 +2278,7 @@ mod tests {
             (3, input(2, false, 0.3, 0.0), bodies(4, 5)),
         ];
         let lanes = lanes_of(&cases);
-        let (mut h, mut w, mut cold, dv) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
+        let (mut h, arms, mut w, mut cold, dv) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
         // Impact speeds and loads as the substeps would leave them: every point bounces but
         // lane 2's second (slower than the 1 m/s threshold); lane 1 had little energy.
         for (i, approach) in [[-3.0, -2.0, -2.5, 0.0], [-2.5, 0.0, -0.5, 0.0]]
@@ -2264,19 +2295,19 @@ mod tests {
         let scalar: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
         let mut expected = Vec::new();
         for l in 0..3 {
-            let mut cc = lane_call!(unpack_full(&h, &w, &cold, &soft, l));
+            let mut cc = lane_call!(unpack_full(&h, &arms, &w, &cold, &soft, l));
             restitution_one(&mut cc, &scalar);
             expected.push(cc);
         }
         let wide: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
         let before = (h, w);
-        lane_call!(restitution(&mut h, &mut w, &dv, &cold, &wide));
+        lane_call!(restitution(&mut h, &arms, &mut w, &dv, &cold, &wide));
         let bits = |s: BodyState| [s.v.x, s.v.y, s.w].map(f32::to_bits);
         for (k, (x, y)) in wide.iter().zip(&scalar).enumerate() {
             assert_eq!(bits(x.get()), bits(y.get()), "body {k}");
         }
         for (l, cc) in expected.iter().enumerate() {
-            let u = lane_call!(unpack_full(&h, &w, &cold, &soft, l));
+            let u = lane_call!(unpack_full(&h, &arms, &w, &cold, &soft, l));
             for i in 0..cc.count {
                 let f = |p: &ConstraintPoint| {
                     [p.normal_impulse, p.total_normal_impulse, p.max_normal_impulse].map(f32::to_bits)
@@ -2292,7 +2323,7 @@ mod tests {
         let (mut free_h, mut free_w, mut free_cold) = (before.0, before.1, cold);
         free_cold.kinetic_energy[1] = 1e6;
         let fresh: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
-        lane_call!(restitution(&mut free_h, &mut free_w, &dv, &free_cold, &fresh));
+        lane_call!(restitution(&mut free_h, &arms, &mut free_w, &dv, &free_cold, &fresh));
         let lam = before.0.points[0].normal_impulse[1];
         let (capped, free) = (
             h.points[0].normal_impulse[1] - lam,

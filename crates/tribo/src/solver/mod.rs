@@ -803,49 +803,71 @@ pub(crate) fn for_each_mut2<A: Send, B: Send>(
     });
 }
 
-/// [`for_each_mut`] over four slices by chunks of `min_len`: `f(first, a, b, c, d)` gets a
-/// chunk of each slice (its first element at index `first`), so it can look ahead inside
+/// Mutable slices cut together into chunks ([`for_each_chunk_mut`]): a tuple of
+/// `&mut [T]`, of four or five element types.
+pub(crate) trait SliceTuple: Sized + Send {
+    /// The shortest slice's length (the slices are meant to have one length).
+    fn len(&self) -> usize;
+    /// Each slice cut at `at` (at most its length): the parts before and from it.
+    fn split_at(self, at: usize) -> (Self, Self);
+}
+
+macro_rules! slice_tuple {
+    ($($t:ident $v:ident),+) => {
+        impl<'a, $($t: Send),+> SliceTuple for ($(&'a mut [$t],)+) {
+            fn len(&self) -> usize {
+                let ($($v,)+) = self;
+                let mut n = usize::MAX;
+                $(n = n.min($v.len());)+
+                n
+            }
+            fn split_at(self, at: usize) -> (Self, Self) {
+                let ($($v,)+) = self;
+                $(let $v = $v.split_at_mut(at.min($v.len()));)+
+                (($($v.0,)+), ($($v.1,)+))
+            }
+        }
+    };
+}
+slice_tuple!(A a, B b, C c, D d);
+slice_tuple!(A a, B b, C c, D d, E e);
+
+/// [`for_each_mut`] over a tuple of slices by chunks of `min_len`: `f(first, chunks)` gets
+/// a chunk of each slice (its first element at index `first`), so it can look ahead inside
 /// the chunk. One chunk on one thread; on threads, thread `k` claims the `k`-th run of
 /// chunks first, as [`claim_each`] shares them out.
-pub(crate) fn for_each_chunk_mut4<A: Send, B: Send, C: Send, D: Send>(
+pub(crate) fn for_each_chunk_mut<S: SliceTuple>(
     parallel: bool,
-    slices: (&mut [A], &mut [B], &mut [C], &mut [D]),
+    slices: S,
     min_len: usize,
-    f: impl Fn(usize, &mut [A], &mut [B], &mut [C], &mut [D]) + Sync,
+    f: impl Fn(usize, S) + Sync,
 ) {
     if !parallel {
-        let (a, b, c, d) = slices;
-        f(0, a, b, c, d);
+        f(0, slices);
         return;
     }
     let n = min_len.max(1);
-    let len = slices
-        .0
-        .len()
-        .min(slices.1.len())
-        .min(slices.2.len())
-        .min(slices.3.len());
-    let chunks = len.div_ceil(n);
+    let chunks = slices.len().div_ceil(n);
     let shares = rayon::current_num_threads().min(chunks).max(1);
     let owners: Vec<(usize, usize)> = (0..shares).map(|k| (k * chunks / shares * n, k)).collect();
-    for_each_chunk_mut4_owned(slices, &owners, n, f);
+    for_each_chunk_mut_owned(slices, &owners, n, f);
 }
 
-/// [`for_each_chunk_mut4`] on threads, with each thread's share given: `owners` lists
+/// [`for_each_chunk_mut`] on threads, with each thread's share given: `owners` lists
 /// where each thread's part of the slices starts (ascending starts, each with its thread;
 /// the first from 0), and each part is cut into chunks of at most `min_len` that its
 /// thread claims first ([`claim_each_share`]). The slices have one length; without
 /// owners, the first thread's share is all of them.
-pub(crate) fn for_each_chunk_mut4_owned<A: Send, B: Send, C: Send, D: Send>(
-    slices: (&mut [A], &mut [B], &mut [C], &mut [D]),
+pub(crate) fn for_each_chunk_mut_owned<S: SliceTuple>(
+    slices: S,
     owners: &[(usize, usize)],
     min_len: usize,
-    f: impl Fn(usize, &mut [A], &mut [B], &mut [C], &mut [D]) + Sync,
+    f: impl Fn(usize, S) + Sync,
 ) {
     let threads = rayon::current_num_threads();
     let n = min_len.max(1);
-    let (mut a, mut b, mut c, mut d) = slices;
-    let len = a.len().min(b.len()).min(c.len()).min(d.len());
+    let len = slices.len();
+    let mut rest = slices;
     let mut shares: Vec<Vec<_>> = (0..threads).map(|_| Vec::new()).collect();
     let mut at = 0usize;
     let owners = if owners.is_empty() { &[(0, 0)][..] } else { owners };
@@ -853,18 +875,15 @@ pub(crate) fn for_each_chunk_mut4_owned<A: Send, B: Send, C: Send, D: Send>(
         let end = owners.get(i + 1).map_or(len, |o| o.0.min(len));
         while at < end {
             let m = (end - at).min(n);
-            let (w, w_rest) = core::mem::take(&mut a).split_at_mut(m);
-            let (x, x_rest) = core::mem::take(&mut b).split_at_mut(m);
-            let (y, y_rest) = core::mem::take(&mut c).split_at_mut(m);
-            let (z, z_rest) = core::mem::take(&mut d).split_at_mut(m);
-            (a, b, c, d) = (w_rest, x_rest, y_rest, z_rest);
+            let (chunk, after) = rest.split_at(m);
+            rest = after;
             if let Some(share) = shares.get_mut(k.min(threads - 1)) {
-                share.push((at, (w, x, y, z)));
+                share.push((at, chunk));
             }
             at += m;
         }
     }
-    claim_each_share(true, shares, |(first, (w, x, y, z))| f(first, w, x, y, z));
+    claim_each_share(true, shares, |(first, chunk)| f(first, chunk));
 }
 
 /// A family of constraints solved by the step (contacts now; joints later). The set is
@@ -1223,7 +1242,7 @@ pub(crate) fn integrate_position_one<S: StateCell>(ctx: &StepContext, sim: &Body
 
 #[cfg(test)]
 mod claim_tests {
-    use super::{claim_each, for_each_chunk_mut4, for_each_chunk_mut4_owned};
+    use super::{claim_each, for_each_chunk_mut, for_each_chunk_mut_owned};
     use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
 
     /// Every item runs exactly once, on two threads as on one, for counts below, at and
@@ -1251,7 +1270,8 @@ mod claim_tests {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("pool");
         let (mut a, mut b, mut c, mut d) = (vec![0usize; 1001], vec![0u8; 1001], vec![0u8; 1001], vec![0u8; 1001]);
         pool.install(|| {
-            for_each_chunk_mut4(true, (&mut a, &mut b, &mut c, &mut d), 32, |first, ws, xs, ys, zs| {
+            let slices = (&mut a[..], &mut b[..], &mut c[..], &mut d[..]);
+            for_each_chunk_mut(true, slices, 32, |first, (ws, xs, ys, zs)| {
                 let rows = ws.iter_mut().zip(xs.iter_mut()).zip(ys.iter_mut()).zip(zs.iter_mut());
                 for (k, (((w, x), y), z)) in rows.enumerate() {
                     *w = first + k;
@@ -1276,11 +1296,11 @@ mod claim_tests {
         let (mut a, mut b, mut c, mut d) = (vec![0usize; n], vec![0u8; n], vec![0u8; n], vec![0u8; n]);
         let chunks = std::sync::Mutex::new(Vec::new());
         pool.install(|| {
-            for_each_chunk_mut4_owned(
-                (&mut a, &mut b, &mut c, &mut d),
+            for_each_chunk_mut_owned(
+                (&mut a[..], &mut b[..], &mut c[..], &mut d[..]),
                 &owners,
                 32,
-                |first, ws, xs, ys, zs| {
+                |first, (ws, xs, ys, zs)| {
                     chunks.lock().expect("chunk list").push((first, ws.len()));
                     let rows = ws.iter_mut().zip(xs.iter_mut()).zip(ys.iter_mut()).zip(zs.iter_mut());
                     for (k, (((w, x), y), z)) in rows.enumerate() {

@@ -18,7 +18,7 @@ use crate::math::{Rot, Vec2};
 use crate::solver::candidates::{Candidate, Candidates, ColourKey};
 use crate::solver::WideContacts;
 use crate::solver::{
-    claim_each, claim_into, for_each_chunk_mut4, for_each_mut, loads, solve_step, BodySim, BodyState, SharedState,
+    claim_each, claim_into, for_each_chunk_mut, for_each_mut, loads, solve_step, BodySim, BodyState, SharedState,
     SolverBody, StepConstraints, StepContext,
 };
 use crate::world::Arena;
@@ -518,11 +518,13 @@ impl World {
             keys.as_mut_slice(),
             outcomes.as_mut_slice(),
         );
-        let run = |first: usize,
-                   slots: &mut [Option<Contact>],
-                   cands: &mut [Candidate],
-                   keys: &mut [ColourKey],
-                   outs: &mut [(NarrowOutcome, bool)]| {
+        type Chunk<'c> = (
+            &'c mut [Option<Contact>],
+            &'c mut [Candidate],
+            &'c mut [ColourKey],
+            &'c mut [(NarrowOutcome, bool)],
+        );
+        let run = |first: usize, (slots, cands, keys, outs): Chunk<'_>| {
             let mut collided = 0u32;
             let len = slots.len();
             // The active contacts of this chunk (all its slots when mostly awake).
@@ -615,9 +617,9 @@ impl World {
             collided_total.fetch_add(collided, core::sync::atomic::Ordering::Relaxed);
         };
         if owners.len() > 1 {
-            crate::solver::for_each_chunk_mut4_owned(slices, &owners, CONTACT_CHUNK, run);
+            crate::solver::for_each_chunk_mut_owned(slices, &owners, CONTACT_CHUNK, run);
         } else {
-            for_each_chunk_mut4(parallel, slices, CONTACT_CHUNK, run);
+            for_each_chunk_mut(parallel, slices, CONTACT_CHUNK, run);
         }
         // Of the contacts visited: every slot when mostly awake, else the listed ones.
         let visited = if mostly_awake {
