@@ -410,6 +410,23 @@ pub(crate) fn array_of<T: Copy + Default, const N: usize>(mut f: impl FnMut(usiz
     out
 }
 
+/// [`array_of`] written out element by element, for `N` ≤ 8: no loop for the compiler to
+/// unroll or not (the solver's gather, see `contact_wide::gather`).
+#[inline(always)]
+pub(crate) fn unrolled<T: Copy + Default, const N: usize>(mut f: impl FnMut(usize) -> T) -> [T; N] {
+    const { assert!(N <= 8) };
+    let mut out = [T::default(); N];
+    macro_rules! each {
+        ($($k:literal)*) => {
+            $(if let Some(x) = out.get_mut($k) {
+                *x = f($k);
+            })*
+        };
+    }
+    each!(0 1 2 3 4 5 6 7);
+    out
+}
+
 /// The 4×4 transpose: lane `j` of output `i` is lane `i` of input `j` (turns four bodies'
 /// 16-byte rows into four lanes of each field and back; `_MM_TRANSPOSE4_PS`, eight
 /// shuffles instead of sixteen single-lane moves).

@@ -34,7 +34,7 @@
 //! [`team_loop`]: ContactSolver::team_loop
 
 use super::contact_wide::{
-    self, StoredContact, WideArms, WideCold, WideContact, WideDerived, WideHead, COLORS, DYNAMIC_COLORS,
+    self, StoredContact, WideArms, WideCold, WideContact, WideDerived, WideHead, WideRare, COLORS, DYNAMIC_COLORS,
 };
 use super::wide::{array_of, LANES};
 use crate::collision::contact::{Contact, ContactSums, NO_COLOUR};
@@ -84,6 +84,9 @@ pub(crate) struct ContactSolver {
     derived: Vec<WideDerived>,
     /// Per group: its points' anchors (what the warm start, restitution and the store read).
     arms: Vec<WideArms>,
+    /// Per group: what only groups with restitution, rolling resistance or a surface speed
+    /// use ([`WideRare`]).
+    rare: Vec<WideRare>,
     /// Constraints that found no colour, whole (solved first in each pass).
     overflow: Vec<ContactConstraint>,
     /// Constraints whose points are all new this step and touching (those the warm-start
@@ -200,14 +203,16 @@ type TeamCuts = Vec<Vec<Vec<usize>>>;
 
 /// A colour's block: its groups (the mutex only hands the claiming thread its `&mut`; it
 /// is never contended).
-type GroupBlock<'a> = TeamBlock<
-    std::sync::Mutex<(
-        &'a mut [WideHead],
-        &'a [WideArms],
-        &'a mut [WideContact],
-        &'a [WideDerived],
-    )>,
->;
+type GroupBlock<'a> = TeamBlock<std::sync::Mutex<GroupBlockParts<'a>>>;
+
+/// A colour's block's part of each group array the passes read.
+type GroupBlockParts<'a> = (
+    &'a mut [WideHead],
+    &'a [WideArms],
+    &'a mut [WideRare],
+    &'a mut [WideContact],
+    &'a [WideDerived],
+);
 
 /// One part of a pass for the substep team: its blocks, thread `k`'s own ones being
 /// `blocks[shares[k] .. shares[k + 1]]` (see `ContactSolver::team_blocks`).
@@ -291,10 +296,11 @@ fn split_shares<S: SliceTuple>(arrays: S, chunks: &BuildChunks, threads: usize) 
 /// ([`ContactSolver::build_shares`]).
 type BuildChunks = Vec<(core::ops::Range<usize>, usize)>;
 
-/// A run of groups' five arrays.
+/// A run of groups' six arrays.
 type GroupChunk<'a> = (
     &'a mut [WideHead],
     &'a mut [WideArms],
+    &'a mut [WideRare],
     &'a mut [WideContact],
     &'a mut [WideCold],
     &'a mut [WideDerived],
@@ -404,7 +410,7 @@ impl ContactSolver {
         // each thread builds the groups it will solve (see `build_shares`).
         let shares = self.build_shares(ctx, sims.len());
         let lane_candidates = &self.lane_candidates;
-        let build_chunk = |first: usize, (heads, arms, wides, colds, derived): GroupChunk<'_>| {
+        let build_chunk = |first: usize, (heads, arms, rares, wides, colds, derived): GroupChunk<'_>| {
             for k in 0..heads.len() {
                 let g = first + k;
                 if let Some(ahead) = lane_candidates.get(g + PREFETCH_GROUPS) {
@@ -427,28 +433,31 @@ impl ContactSolver {
                     crate::solver::prefetch(c);
                     crate::solver::prefetch(d);
                 }
-                if let Some(r) = arms.get(k + PREFETCH_GROUPS) {
+                if let (Some(r), Some(rare)) = (arms.get(k + PREFETCH_GROUPS), rares.get(k + PREFETCH_GROUPS)) {
                     crate::solver::prefetch(r);
+                    crate::solver::prefetch(rare);
                 }
                 let lanes = array_of(|l| {
                     candidates
                         .get(lane_candidates[g][l] as usize)
                         .map(|cand| (cand.contact, &cand.input, &cand.bodies))
                 });
-                if let (Some(h), Some(r), Some(w), Some(cold), Some(dv)) = (
+                if let (Some(h), Some(r), Some(rare), Some(w), Some(cold), Some(dv)) = (
                     heads.get_mut(k),
                     arms.get_mut(k),
+                    rares.get_mut(k),
                     wides.get_mut(k),
                     colds.get_mut(k),
                     derived.get_mut(k),
                 ) {
-                    contact_wide::build_group(h, r, w, cold, dv, lanes, up, ctx, states);
+                    contact_wide::build_group(h, r, rare, w, cold, dv, lanes, up, ctx, states);
                 }
             }
         };
         let arrays = (
             &mut self.head[..],
             &mut self.arms[..],
+            &mut self.rare[..],
             &mut self.wide[..],
             &mut self.cold[..],
             &mut self.derived[..],
@@ -597,6 +606,8 @@ impl ContactSolver {
         self.derived.truncate(groups as usize);
         self.arms.resize(groups as usize, WideArms::default());
         self.arms.truncate(groups as usize);
+        self.rare.resize(groups as usize, WideRare::default());
+        self.rare.truncate(groups as usize);
         // 3. Slots: overflow constraints are built here, coloured ones below.
         let soft = self.soft;
         // Locals again for the loop (see step 1).
@@ -847,6 +858,7 @@ impl ContactSolver {
                 contact_wide::unpack_full(
                     &self.head[g],
                     &self.arms[g],
+                    &self.rare[g],
                     &self.wide[g],
                     &self.cold[g],
                     &self.soft,
@@ -869,10 +881,11 @@ impl ContactSolver {
                     let (da, db) = (h.write_a[lane as usize], h.write_b[lane as usize]);
                     // (The lane's geometry comes back as it was unpacked, so the group's
                     // derived part is made again with the same bits.)
-                    let (arms, cold, dv) = (&mut self.arms[g], &mut self.cold[g], &mut self.derived[g]);
-                    contact_wide::pack(h, arms, w, cold, dv, lane as usize, cc, da, db);
+                    let (arms, rare) = (&mut self.arms[g], &mut self.rare[g]);
+                    let (cold, dv) = (&mut self.cold[g], &mut self.derived[g]);
+                    contact_wide::pack(h, arms, rare, w, cold, dv, lane as usize, cc, da, db);
                 } else {
-                    contact_wide::pack_state(h, w, lane as usize, cc);
+                    contact_wide::pack_state(h, &mut self.rare[g], w, lane as usize, cc);
                 }
             }
             Slot::Overflow(i) => self.overflow[i as usize] = *cc,
@@ -995,9 +1008,13 @@ impl ContactSolver {
     ) {
         let at = |contact: u32| (contact as usize).wrapping_sub(base);
         for g in range.clone() {
-            let (Some(h), Some(arms), Some(w), Some(cold)) =
-                (self.head.get(g), self.arms.get(g), self.wide.get(g), self.cold.get(g))
-            else {
+            let (Some(h), Some(arms), Some(rare), Some(w), Some(cold)) = (
+                self.head.get(g),
+                self.arms.get(g),
+                self.rare.get(g),
+                self.wide.get(g),
+                self.cold.get(g),
+            ) else {
                 continue;
             };
             if let (Some(ahead), Some(ahead_cold)) = (
@@ -1019,7 +1036,7 @@ impl ContactSolver {
                     }
                 }
             }
-            let out = contact_wide::store_group(h, arms, w, cold, states, ctx);
+            let out = contact_wide::store_group(h, arms, rare, w, cold, states, ctx);
             let (Some(lanes), Some(&colour)) = (self.lane_candidates.get(g), self.group_colour.get(g)) else {
                 continue;
             };
@@ -1085,11 +1102,11 @@ impl ContactSolver {
             warm_start_one(cc, states);
         }
         for &(start, end) in &self.ranges {
-            let colour = &mut self.head[start as usize..end as usize];
-            let arms = &self.arms[start as usize..end as usize];
-            S::for_each_mut(states, colour, GROUP_CHUNK, |i, h, states| {
-                if let Some(r) = arms.get(i) {
-                    contact_wide::warm_start(h, r, states)
+            let range = start as usize..end as usize;
+            let (heads, arms) = (&self.head[range.clone()], &self.arms[range.clone()]);
+            S::for_each_mut(states, &mut self.rare[range], GROUP_CHUNK, |i, rare, states| {
+                if let (Some(h), Some(r)) = (heads.get(i), arms.get(i)) {
+                    contact_wide::warm_start(h, r, rare, states)
                 }
             });
         }
@@ -1104,21 +1121,23 @@ impl ContactSolver {
         let soft = &self.soft;
         // Colour after colour; the groups of one colour share no moving body.
         for &(start, end) in &self.ranges {
-            let (heads, colour, derived) = (
-                &mut self.head[start as usize..end as usize],
-                &mut self.wide[start as usize..end as usize],
-                &self.derived[start as usize..end as usize],
+            let range = start as usize..end as usize;
+            let groups = (
+                &mut self.head[range.clone()],
+                &mut self.rare[range.clone()],
+                &mut self.wide[range.clone()],
             );
+            let derived = &self.derived[range];
             if use_bias {
-                S::for_each_mut2(states, heads, colour, GROUP_CHUNK, |i, h, w, states| {
+                S::for_each_mut3(states, groups, GROUP_CHUNK, |i, h, rare, w, states| {
                     if let Some(dv) = derived.get(i) {
-                        contact_wide::solve::<true, S>(h, w, dv, states, ctx, soft, elapsed)
+                        contact_wide::solve::<true, S>(h, rare, w, dv, states, ctx, soft, elapsed)
                     }
                 });
             } else {
-                S::for_each_mut2(states, heads, colour, GROUP_CHUNK, |i, h, w, states| {
+                S::for_each_mut3(states, groups, GROUP_CHUNK, |i, h, rare, w, states| {
                     if let Some(dv) = derived.get(i) {
-                        contact_wide::solve::<false, S>(h, w, dv, states, ctx, soft, elapsed)
+                        contact_wide::solve::<false, S>(h, rare, w, dv, states, ctx, soft, elapsed)
                     }
                 });
             }
@@ -1166,12 +1185,13 @@ impl ContactSolver {
             .head
             .iter_mut()
             .zip(&self.arms)
+            .zip(&self.rare)
             .zip(self.wide.iter_mut())
             .zip(&self.derived)
             .zip(&self.cold);
-        for ((((h, arms), w), dv), cold) in groups {
+        for (((((h, arms), rare), w), dv), cold) in groups {
             if cold.any_restitution {
-                contact_wide::restitution(h, arms, w, dv, cold, states);
+                contact_wide::restitution(h, arms, rare, w, dv, cold, states);
             }
         }
     }
@@ -1254,19 +1274,20 @@ impl ContactSolver {
             let mut lap = Stopwatch::start();
             let mut t = [0.0f32; 5];
             let mut at = TeamCursor::default();
-            type Pass<'p> = &'p dyn Fn(&mut WideHead, &WideArms, &mut WideContact, &WideDerived);
+            type Pass<'p> = &'p dyn Fn(&mut WideHead, &WideArms, &mut WideRare, &mut WideContact, &WideDerived);
             let each_colour = |at: &mut TeamCursor, f: Pass<'_>| {
                 for parts in &colours {
                     team_pass(parts, k, at, &progress, |part| {
                         let mut guard = part.lock().unwrap_or_else(|e| e.into_inner());
-                        let (heads, arms, wides, derived) = &mut *guard;
+                        let (heads, arms, rares, wides, derived) = &mut *guard;
                         let groups = heads
                             .iter_mut()
                             .zip(arms.iter())
+                            .zip(rares.iter_mut())
                             .zip(wides.iter_mut())
                             .zip(derived.iter());
-                        for (((h, r), w), dv) in groups {
-                            f(h, r, w, dv);
+                        for ((((h, r), rare), w), dv) in groups {
+                            f(h, r, rare, w, dv);
                         }
                     });
                 }
@@ -1279,18 +1300,20 @@ impl ContactSolver {
                     }
                 });
                 t[0] += lap.lap();
-                each_colour(&mut at, &|h, r, _, _| contact_wide::warm_start(h, r, states));
+                each_colour(&mut at, &|h, r, rare, _, _| {
+                    contact_wide::warm_start(h, r, rare, states)
+                });
                 t[1] += lap.lap();
-                each_colour(&mut at, &|h, _, w, dv| {
-                    contact_wide::solve::<true, SharedState>(h, w, dv, states, ctx, &soft, elapsed)
+                each_colour(&mut at, &|h, _, rare, w, dv| {
+                    contact_wide::solve::<true, SharedState>(h, rare, w, dv, states, ctx, &soft, elapsed)
                 });
                 t[2] += lap.lap();
                 team_pass(&bodies, k, &mut at, &progress, |range| {
                     integrate_positions_range(ctx, sims, states, range.clone());
                 });
                 t[3] += lap.lap();
-                each_colour(&mut at, &|h, _, w, dv| {
-                    contact_wide::solve::<false, SharedState>(h, w, dv, states, ctx, &soft, elapsed + ctx.h)
+                each_colour(&mut at, &|h, _, rare, w, dv| {
+                    contact_wide::solve::<false, SharedState>(h, rare, w, dv, states, ctx, &soft, elapsed + ctx.h)
                 });
                 t[4] += lap.lap();
             }
@@ -1470,39 +1493,39 @@ impl ContactSolver {
             Some((at, cuts)) if at == id => cuts,
             _ => self.team_cuts(threads, per_thread),
         };
-        let (mut heads, mut wides): (&mut [WideHead], &mut [WideContact]) = (&mut self.head, &mut self.wide);
-        let mut derived: &[WideDerived] = &self.derived;
-        let mut arms: &[WideArms] = &self.arms;
+        // The arrays the passes write, cut together; those they only read, alongside.
+        let mut written = (&mut self.head[..], &mut self.rare[..], &mut self.wide[..]);
+        let (mut arms, mut derived): (&[WideArms], &[WideDerived]) = (&self.arms, &self.derived);
         let mut taken = 0usize;
         let mut colours = Vec::with_capacity(cuts.len());
         for parts in &cuts {
             let mut out = Vec::with_capacity(parts.len());
             for at in parts {
-                let (_, h_rest) = core::mem::take(&mut heads).split_at_mut(at[0] - taken);
-                let (_, w_rest) = core::mem::take(&mut wides).split_at_mut(at[0] - taken);
-                let (_, d_rest) = derived.split_at(at[0] - taken);
-                let (_, r_rest) = arms.split_at(at[0] - taken);
-                (heads, wides, derived, arms, taken) = (h_rest, w_rest, d_rest, r_rest, at[0]);
+                let skip = at[0].saturating_sub(taken);
+                written = written.split_at(skip).1;
+                (arms, derived) = (arms.get(skip..).unwrap_or(&[]), derived.get(skip..).unwrap_or(&[]));
+                taken = at[0];
                 let mut part = TeamPart {
                     blocks: Vec::new(),
                     shares: Vec::with_capacity(threads + 1),
                 };
                 for k in 0..threads {
                     part.shares.push(part.blocks.len());
-                    let len = at[k + 1] - at[k];
-                    let (h, h_rest) = core::mem::take(&mut heads).split_at_mut(len);
-                    let (w, w_rest) = core::mem::take(&mut wides).split_at_mut(len);
-                    let (d, d_rest) = derived.split_at(len);
-                    let (r, r_rest) = arms.split_at(len);
-                    (heads, wides, derived, arms, taken) = (h_rest, w_rest, d_rest, r_rest, at[k + 1]);
+                    let len = at[k + 1].saturating_sub(at[k]);
+                    let ((h, x, w), rest) = written.split_at(len);
+                    let (r, d) = (arms.get(..len).unwrap_or(arms), derived.get(..len).unwrap_or(derived));
+                    written = rest;
+                    (arms, derived) = (arms.get(len..).unwrap_or(&[]), derived.get(len..).unwrap_or(&[]));
+                    taken = at[k + 1];
                     let blocks = h
                         .chunks_mut(TEAM_BLOCK)
                         .zip(r.chunks(TEAM_BLOCK))
+                        .zip(x.chunks_mut(TEAM_BLOCK))
                         .zip(w.chunks_mut(TEAM_BLOCK))
                         .zip(d.chunks(TEAM_BLOCK));
-                    for (((hs, rs), ws), ds) in blocks {
+                    for ((((hs, rs), xs), ws), ds) in blocks {
                         part.blocks
-                            .push(TeamBlock::new(std::sync::Mutex::new((hs, rs, ws, ds))));
+                            .push(TeamBlock::new(std::sync::Mutex::new((hs, rs, xs, ws, ds))));
                     }
                 }
                 part.shares.push(part.blocks.len());
@@ -1520,7 +1543,7 @@ impl ContactSolver {
         match slot {
             Slot::Wide { group, lane } => {
                 let g = group as usize;
-                contact_wide::unpack_state(&self.head[g], &self.wide[g], lane as usize, cc)
+                contact_wide::unpack_state(&self.head[g], &self.rare[g], &self.wide[g], lane as usize, cc)
             }
             Slot::Overflow(i) => *cc = self.overflow[i as usize],
         }

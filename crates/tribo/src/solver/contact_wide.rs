@@ -33,7 +33,7 @@
 //! agrees with the scalar solve to 1e-4 (`two_point_solve_matches_scalar_solve`). A
 //! contact is solved one way for a whole step.
 
-use super::wide::{array_of, lanes_to_rows, rows_to_lanes, F4, FL, LANES, ML, VL};
+use super::wide::{array_of, lanes_to_rows, rows_to_lanes, unrolled, F4, FL, LANES, ML, VL};
 use crate::collision::contact::{Contact, ContactSums, FrictionState, PointState, PointSums};
 use crate::math::Vec2;
 use crate::solver::contact_solver::{
@@ -57,9 +57,6 @@ pub(crate) struct WidePoint {
     pub preload: FL,
     pub total_normal_impulse: FL,
     pub max_normal_impulse: FL,
-    /// `ConstraintPoint::approach`, tracked only in groups with restitution (0 elsewhere:
-    /// a point without restitution never bounces, whatever its approach).
-    pub approach: FL,
 }
 
 /// One point of four constraints: what the warm start reads and writes and the solve
@@ -67,9 +64,6 @@ pub(crate) struct WidePoint {
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct HeadPoint {
     pub normal_impulse: FL,
-    /// `ConstraintPoint::substep_vn`, recorded only in groups with restitution
-    /// ([`WideHead::any_restitution`]).
-    pub substep_vn: FL,
 }
 
 /// The part of four constraints the warm start needs (bodies, normal, masses, anchors,
@@ -88,8 +82,11 @@ pub(crate) struct WideHead {
     pub write_b: [bool; LANES],
     pub any_rolling: bool,
     /// Some lane has restitution: only then do the passes record the points' approach
-    /// speeds (what restitution reads).
+    /// speeds (what restitution reads, in [`WideRare`]).
     pub any_restitution: bool,
+    /// Some lane has a surface speed (a conveyor): only then do the passes read it (in
+    /// [`WideRare`]; +0.0 in every lane otherwise).
+    pub any_surface_speed: bool,
     pub normal: VL,
     pub inv_mass_a: FL,
     pub inv_i_a: FL,
@@ -104,7 +101,6 @@ pub(crate) struct WideHead {
     /// Lanes with a two-point manifold: the friction row sits at the patch middle and each
     /// point reports half its impulse (one point: the whole).
     pub two_points: ML,
-    pub rolling_impulse: FL,
 }
 
 /// One point's anchors in four constraints, from the bodies' centres at the step start
@@ -127,6 +123,28 @@ pub(crate) struct WideArms {
     pub points: [PointArms; 2],
 }
 
+/// What only some groups use: restitution's speeds, the rolling resistance row, the
+/// surface speed. In an array of its own (as [`WideArms`]): the passes touch a group's
+/// only where its flags say the group uses it ([`WideHead::any_restitution`],
+/// `any_rolling`, `any_surface_speed`), so the groups without them do not stream these
+/// 224 bytes (8 lanes) in every pass. The build, [`pack`] and the store read or write all
+/// of it.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct WideRare {
+    /// `ConstraintPoint::approach` of each point, tracked only in groups with restitution
+    /// (0 elsewhere: a point without restitution never bounces, whatever its approach).
+    pub approach: [FL; 2],
+    /// `ConstraintPoint::substep_vn` of each point, recorded only in groups with
+    /// restitution.
+    pub substep_vn: [FL; 2],
+    /// Rolling resistance impulse [N·m·s] (warm start).
+    pub rolling_impulse: FL,
+    /// Rolling resistance coefficient (`ContactConstraint::rolling_resistance`).
+    pub rolling_resistance: FL,
+    /// Surface speed along the tangent [m/s] (`ContactConstraint::tangent_speed`).
+    pub tangent_speed: FL,
+}
+
 /// The rest of four contact constraints, one per lane (see the module docs): what only
 /// the solve passes read.
 ///
@@ -141,14 +159,12 @@ pub(crate) struct WideArms {
 pub(crate) struct WideContact {
     /// Friction coefficient of the row this step: μs where it sticks, μd where it slides.
     pub mu: FL,
-    pub tangent_speed: FL,
-    pub rolling_resistance: FL,
     pub points: [WidePoint; 2],
-    /// Normal-row matrix K and 1/det K (2-point manifolds with `block`, else 0).
+    /// Normal-row matrix K (2-point manifolds with `block`, else 0); 1/det K is in
+    /// [`WideCold`] (the passes read K⁻¹ in [`WideDerived`]).
     pub k11: FL,
     pub k12: FL,
     pub k22: FL,
-    pub inv_det: FL,
     pub block: ML,
     pub tangent_mass: FL,
     pub base_drift: FL,
@@ -162,6 +178,8 @@ pub(crate) struct WideContact {
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WideCold {
     pub contact: [u32; LANES],
+    /// 1/det K of each lane (where the block applies, else 0).
+    pub inv_det: [f32; LANES],
     pub mu_s: [f32; LANES],
     pub mu_d: [f32; LANES],
     /// Manifold points of each lane (0 for an empty lane).
@@ -206,7 +224,7 @@ impl WideDerived {
     /// anchors and normal (in `h`) and its K and 1/det K: the expressions the passes
     /// evaluated each time, so the same bits.
     #[inline(always)]
-    fn new(friction: (VL, VL), t: VL, h: &WideHead, arms: &WideArms, w: &WideContact) -> WideDerived {
+    fn new(friction: (VL, VL), t: VL, h: &WideHead, arms: &WideArms, w: &WideContact, inv_det: FL) -> WideDerived {
         WideDerived {
             fr_moments: moments(friction, t),
             // Spelled out, not `map`ped (see `point_impulse`).
@@ -214,9 +232,9 @@ impl WideDerived {
                 moments((arms.points[0].r_a, arms.points[0].r_b), h.normal),
                 moments((arms.points[1].r_a, arms.points[1].r_b), h.normal),
             ],
-            i11: w.k22 * w.inv_det,
-            i12: -w.k12 * w.inv_det,
-            i22: w.k11 * w.inv_det,
+            i11: w.k22 * inv_det,
+            i12: -w.k12 * inv_det,
+            i22: w.k11 * inv_det,
         }
     }
 }
@@ -225,8 +243,9 @@ impl WideDerived {
 // (In vectors of lanes: 144, 400 and 416 bytes with four lanes, twice that with eight.)
 const VECTOR: usize = core::mem::size_of::<FL>();
 const _: () = assert!(core::mem::size_of::<WideDerived>() == 9 * VECTOR);
-const _: () = assert!(core::mem::size_of::<WideContact>() == 25 * VECTOR);
-const _: () = assert!(core::mem::size_of::<WideHead>() == 18 * VECTOR);
+const _: () = assert!(core::mem::size_of::<WideContact>() == 20 * VECTOR);
+const _: () = assert!(core::mem::size_of::<WideHead>() == 15 * VECTOR);
+const _: () = assert!(core::mem::size_of::<WideRare>() == 7 * VECTOR);
 const _: () = assert!(core::mem::size_of::<WideArms>() == 8 * VECTOR);
 
 /// Four bodies' velocities and step motion, gathered from `BodyState`s.
@@ -244,12 +263,10 @@ struct WideBody {
 /// transposed into lanes.
 #[inline(always)]
 fn gather<S: StateRead>(states: &[S], idx: &[u32; LANES]) -> WideBody {
-    // Lane by lane in a loop the compiler unrolls: `idx.map(…)` over eight lanes was
-    // compiled as a call, its rows passed back through the stack.
-    let mut s = [[F4::ZERO; 2]; LANES];
-    for (row, &i) in s.iter_mut().zip(idx) {
-        *row = states[i as usize].rows();
-    }
+    // Lane by lane, written out (`unrolled`): `idx.map(…)` over eight lanes was compiled
+    // as a call, and a loop was not always unrolled (the warm start's was left rolled,
+    // 0.22 → 0.35 ms in large_pyramid); either way the rows went through the stack.
+    let s: [[F4; 2]; LANES] = unrolled(|l| states[idx[l] as usize].rows());
     let [vx, vy, w, touched] = rows_to_lanes(array_of(|l| s[l][0]));
     let [dpx, dpy, _, dq_s] = rows_to_lanes(array_of(|l| s[l][1]));
     WideBody {
@@ -456,7 +473,7 @@ fn point_impulse(c: &WideHead, n: VL, t: VL, i: usize) -> VL {
 /// speed; the only reader, so a group without restitution skips it: large_pyramid's warm
 /// start went from 0.305 to 0.279 ms per step).
 #[super::lane_inline]
-pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, arms: &WideArms, states: &[S]) {
+pub(crate) fn warm_start<S: StateCell>(c: &WideHead, arms: &WideArms, rare: &mut WideRare, states: &[S]) {
     let n = c.normal;
     let t = n.right_perp();
     // Both points' impulses P_i = λn_i n + λt_i t at once: the bodies take their sum P and
@@ -478,7 +495,7 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, arms: &WideArms, states
         for i in 0..2 {
             let p = &arms.points[i];
             let (r_a, r_b) = lever_arms(c, shift, p.r_a, p.r_b);
-            c.points[i].substep_vn = relative_velocity(&a, &b, r_a, r_b).dot(n);
+            rare.substep_vn[i] = relative_velocity(&a, &b, r_a, r_b).dot(n);
         }
     }
     let turn = shift.cross(total);
@@ -489,8 +506,8 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, arms: &WideArms, states
     b.v = b.v + total.scale(c.inv_mass_b);
     b.w += c.inv_i_b * moment_b;
     if c.any_rolling {
-        a.w -= c.inv_i_a * c.rolling_impulse;
-        b.w += c.inv_i_b * c.rolling_impulse;
+        a.w -= c.inv_i_a * rare.rolling_impulse;
+        b.w += c.inv_i_b * rare.rolling_impulse;
     }
     scatter(states, &c.index_a, &c.write_a, &a);
     scatter(states, &c.index_b, &c.write_b, &b);
@@ -507,6 +524,7 @@ pub(crate) fn warm_start<S: StateCell>(c: &mut WideHead, arms: &WideArms, states
 pub(crate) fn restitution<S: StateCell>(
     h: &mut WideHead,
     anchors: &WideArms,
+    rare: &WideRare,
     w: &mut WideContact,
     dv: &WideDerived,
     cold: &WideCold,
@@ -520,7 +538,7 @@ pub(crate) fn restitution<S: StateCell>(
         let p = &w.points[i];
         ML::from_bools(array_of(|l| cold.count[l] as usize > i))
             & e.gt(zero)
-            & minus_threshold.ge(p.approach)
+            & minus_threshold.ge(rare.approach[i])
             & p.max_normal_impulse.gt(zero)
     });
     if !(bounces[0] | bounces[1]).any() {
@@ -555,8 +573,8 @@ pub(crate) fn restitution<S: StateCell>(
     if face.any() {
         let (lam0, lam1) = (h.points[0].normal_impulse, h.points[1].normal_impulse);
         let (pre0, pre1) = (w.points[0].preload, w.points[1].preload);
-        let rhs0 = normal_velocity(&a, &b, 0) + e * w.points[0].approach;
-        let rhs1 = normal_velocity(&a, &b, 1) + e * w.points[1].approach;
+        let rhs0 = normal_velocity(&a, &b, 0) + e * rare.approach[0];
+        let rhs1 = normal_velocity(&a, &b, 1) + e * rare.approach[1];
         let (k11, k12, k22) = (w.k11, w.k12, w.k22);
         let (i11, i12, i22) = (dv.i11, dv.i12, dv.i22);
         let (one, none) = (FL::splat(1.0), FL::ZERO);
@@ -593,7 +611,7 @@ pub(crate) fn restitution<S: StateCell>(
         let (ra, rb) = (r_a.cross(n), r_b.cross(n));
         let k = h.inv_mass_a + h.inv_mass_b + h.inv_i_a * ra * ra + h.inv_i_b * rb * rb;
         let normal_mass = k.gt(zero).select(FL::splat(1.0) / k, zero);
-        let mut impulse = -normal_mass * (vn + e * w.points[i].approach);
+        let mut impulse = -normal_mass * (vn + e * rare.approach[i]);
         // The energy cap: λ ≤ m_n (−vn + √(vn² + 2 room / m_n)), room = KE₀ − KE.
         let capped = impulse.gt(zero) & normal_mass.gt(zero);
         if (capped & m).any() {
@@ -666,6 +684,7 @@ fn soft_row(lam: FL, ms: FL, is: FL, pre: FL, rd: FL) -> FL {
 #[inline(always)]
 fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
     h: &mut WideHead,
+    rare: &mut WideRare,
     c: &mut WideContact,
     dv: &WideDerived,
     a: &mut WideBody,
@@ -768,9 +787,12 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
     {
         hp.normal_impulse = new;
         p.max_normal_impulse = p.max_normal_impulse.max(new);
-        if h.any_restitution {
-            let lower = new.gt(zero) & hp.substep_vn.lt(p.approach);
-            p.approach = lower.select(hp.substep_vn, p.approach);
+    }
+    if h.any_restitution {
+        for (i, new) in [new0, new1].into_iter().enumerate().take(POINTS) {
+            let (vn, approach) = (rare.substep_vn[i], rare.approach[i]);
+            let lower = new.gt(zero) & vn.lt(approach);
+            rare.approach[i] = lower.select(vn, approach);
         }
     }
     (new0, new1)
@@ -788,9 +810,11 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
 /// form (the relative velocity dotted with the row, the impulse vector crossed with each
 /// arm) needed more operations and more registers than SSE's sixteen hold: large_pyramid
 /// ran 4 % fewer instructions, and its solve and relax took 8 % and 10 % less time.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     h: &mut WideHead,
+    rare: &mut WideRare,
     c: &mut WideContact,
     dv: &WideDerived,
     states: &[S],
@@ -821,9 +845,9 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
 
     // Normal rows; groups of single points skip the second point and the block.
     let (new0, new1) = if h.two_points.any() {
-        normal_rows::<USE_BIAS, 2>(h, c, dv, &mut a, &mut b, d, shift, ctx, rows)
+        normal_rows::<USE_BIAS, 2>(h, rare, c, dv, &mut a, &mut b, d, shift, ctx, rows)
     } else {
-        normal_rows::<USE_BIAS, 1>(h, c, dv, &mut a, &mut b, d, shift, ctx, rows)
+        normal_rows::<USE_BIAS, 1>(h, rare, c, dv, &mut a, &mut b, d, shift, ctx, rows)
     };
     if USE_BIAS {
         let pushed = (new0.gt(zero) | new1.gt(zero)).to_unit();
@@ -839,9 +863,12 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
 
     // Friction row (contact_solver::solve_friction).
     let limit = c.mu * (new0 + new1);
-    let vt = row_speed(&a, &b, t, m) - c.tangent_speed;
+    // +0.0 in every lane of a group without a surface speed (the flag is set by any other
+    // bits), so x − 0.0 and 0.0 · elapsed change no bits.
+    let tangent_speed = if h.any_surface_speed { rare.tangent_speed } else { zero };
+    let vt = row_speed(&a, &b, t, m) - tangent_speed;
     let fbias = if USE_BIAS {
-        let drift = disp + c.base_drift - c.tangent_speed * FL::splat(elapsed);
+        let drift = disp + c.base_drift - tangent_speed * FL::splat(elapsed);
         let rate = bias_rate * drift;
         (c.stick & limit.gt(zero)).select(rate.clamp(-push, push), zero)
     } else {
@@ -859,13 +886,13 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
         c.total_tangent_impulse += new;
         c.saturated = limit.gt(zero) & unclamped.abs().gt(limit);
         if h.any_rolling {
-            let rlimit = c.rolling_resistance * (new0 + new1);
+            let rlimit = rare.rolling_resistance * (new0 + new1);
             let k_roll = h.inv_i_a + h.inv_i_b;
             let rolling_mass = k_roll.gt(zero).select(one / k_roll, zero);
             let imp = -(rolling_mass * (b.w - a.w));
-            let rnew = (h.rolling_impulse + imp).clamp(-rlimit, rlimit);
-            let delta = rnew - h.rolling_impulse;
-            h.rolling_impulse = rnew;
+            let rnew = (rare.rolling_impulse + imp).clamp(-rlimit, rlimit);
+            let delta = rnew - rare.rolling_impulse;
+            rare.rolling_impulse = rnew;
             a.w -= h.inv_i_a * delta;
             b.w += h.inv_i_b * delta;
         }
@@ -887,6 +914,7 @@ pub(crate) type LaneInput<'a> = Option<(u32, &'a ContactInput, &'a ConstraintBod
 pub(crate) fn build_group<S: StateRead>(
     head: &mut WideHead,
     anchors: &mut WideArms,
+    rare: &mut WideRare,
     w: &mut WideContact,
     cold: &mut WideCold,
     derived: &mut WideDerived,
@@ -982,13 +1010,9 @@ pub(crate) fn build_group<S: StateRead>(
             zero
         };
         // The step's sums and what restitution tracks start from zero.
-        (
-            hp.substep_vn,
-            wp.total_normal_impulse,
-            wp.max_normal_impulse,
-            wp.approach,
-        ) = (zero, zero, zero, zero);
+        (wp.total_normal_impulse, wp.max_normal_impulse) = (zero, zero);
     }
+    (rare.substep_vn, rare.approach) = ([zero; 2], [zero; 2]);
     (out.total_tangent_impulse, out.saturated) = (zero, ML::default());
     // Summed as `pack_state` sums (`Iterator::sum` of f32 starts at −0.0, and −0.0 + x is
     // x: the same bits, the same sign of a zero sum), without a loop; +0.0 in an empty lane.
@@ -1001,9 +1025,11 @@ pub(crate) fn build_group<S: StateRead>(
     let [mu_s, mu_d, restitution, threshold] = columns(&|input, _| input.material_row());
     (c.mu_s, c.mu_d, c.restitution, c.restitution_threshold) = (*mu_s, *mu_d, *restitution, *threshold);
     let [rolling_resistance, tangent_speed, rolling_impulse, _] = columns(&|input, _| input.surface_row());
-    (out.rolling_resistance, out.tangent_speed) = (rolling_resistance, tangent_speed);
+    (rare.rolling_resistance, rare.tangent_speed) = (rolling_resistance, tangent_speed);
     let used_rolling_impulse = if warm { rolling_impulse } else { zero };
-    hd.rolling_impulse = used_rolling_impulse;
+    rare.rolling_impulse = used_rolling_impulse;
+    // Any lane whose speed is not +0.0 (−0.0 included: the passes then read the speeds).
+    hd.any_surface_speed = (tangent_speed.ne(zero) | tangent_speed.bits_set(0x8000_0000)).any();
     // The group's flags and the points' heights, four lanes at once from the columns (an
     // empty lane's zeros set no flag and give the height 0): the scalar tests and the
     // height's `dot`, lane by lane.
@@ -1100,8 +1126,9 @@ pub(crate) fn build_group<S: StateRead>(
     out.k11 = block.select(k11, zero);
     out.k12 = block.select(k12, zero);
     out.k22 = block.select(k22, zero);
-    out.inv_det = block.select(inv, zero);
-    *derived = WideDerived::new((fr_a, fr_b), t, hd, anchors, out);
+    let inv_det = block.select(inv, zero);
+    c.inv_det = *inv_det;
+    *derived = WideDerived::new((fr_a, fr_b), t, hd, anchors, out, inv_det);
 }
 
 /// `contact_solver::shift_cap2` four lanes at once (the same quotients and minimum; the
@@ -1168,6 +1195,7 @@ fn write_stored(
 pub(crate) fn store_group<S: StateRead>(
     h: &WideHead,
     arms: &WideArms,
+    rare: &WideRare,
     w: &WideContact,
     cold: &WideCold,
     states: &[S],
@@ -1185,7 +1213,7 @@ pub(crate) fn store_group<S: StateRead>(
     for i in 0..2 {
         let p = &arms.points[i];
         let (m, along) = frame.point(&a, &b, p.r_a, p.r_b);
-        (vt[i], disp[i]) = (row_speed(&a, &b, t, m) - w.tangent_speed, along);
+        (vt[i], disp[i]) = (row_speed(&a, &b, t, m) - rare.tangent_speed, along);
     }
     // Four lanes at once; every expression is the scalar store's, in its order.
     let zero = FL::ZERO;
@@ -1229,11 +1257,11 @@ pub(crate) fn store_group<S: StateRead>(
         let total_tangent_out =
             (two & sum_total_n.gt(zero)).select(sum_total_t * total_normal / sum_total_n, total_tangent);
         let drift = (stick & was_stick & loaded).select(
-            disp[i] + FL::new(cold.base_drift[i]) - w.tangent_speed * FL::splat(ctx.dt),
+            disp[i] + FL::new(cold.base_drift[i]) - rare.tangent_speed * FL::splat(ctx.dt),
             zero,
         );
         // next_preload, with `bounces` of the restitution pass.
-        let approach = wp.approach;
+        let approach = rare.approach[i];
         let bounced = restitution.gt(zero) & threshold.ge(approach) & max.gt(zero);
         let released = zero.ge(max) | (fresh & bounced);
         let kept = normal.lt(FL::splat(0.5) * wp.preload).select(zero, wp.preload);
@@ -1249,7 +1277,7 @@ pub(crate) fn store_group<S: StateRead>(
             preload,
         }
     };
-    StoredGroup::new([point(0), point(1)], tangent, h.rolling_impulse, cold.count)
+    StoredGroup::new([point(0), point(1)], tangent, rare.rolling_impulse, cold.count)
 }
 
 /// One point's stored states in the four lanes of a group ([`store_group`]).
@@ -1360,6 +1388,7 @@ impl StoredGroup {
 pub(crate) fn pack(
     h: &mut WideHead,
     arms: &mut WideArms,
+    rare: &mut WideRare,
     w: &mut WideContact,
     cold: &mut WideCold,
     derived: &mut WideDerived,
@@ -1396,8 +1425,9 @@ pub(crate) fn pack(
     h.shift_cap2[l] = cc.shift_cap2;
     cold.mu_s[l] = cc.mu_s;
     cold.mu_d[l] = cc.mu_d;
-    w.tangent_speed[l] = cc.tangent_speed;
-    w.rolling_resistance[l] = cc.rolling_resistance;
+    rare.tangent_speed[l] = cc.tangent_speed;
+    h.any_surface_speed |= cc.tangent_speed.to_bits() != 0;
+    rare.rolling_resistance[l] = cc.rolling_resistance;
     h.any_rolling |= cc.rolling_resistance > 0.0 || cc.rolling_impulse != 0.0;
     for i in 0..2 {
         let (hp, wp) = (&mut arms.points[i], &mut w.points[i]);
@@ -1431,7 +1461,7 @@ pub(crate) fn pack(
     w.k11[l] = k[0];
     w.k12[l] = k[1];
     w.k22[l] = k[2];
-    w.inv_det[l] = if block { cc.inv_det } else { 0.0 };
+    cold.inv_det[l] = if block { cc.inv_det } else { 0.0 };
     w.block[l] = if block { u32::MAX } else { 0 };
     let (p0, p1) = (&cc.points[0], &cc.points[1]);
     // The friction row's anchors follow from the points' (`friction_arms`).
@@ -1449,13 +1479,20 @@ pub(crate) fn pack(
     w.stick[l] = if stick { u32::MAX } else { 0 };
     w.mu[l] = if stick { cc.mu_s } else { cc.mu_d };
     h.two_points[l] = if cc.count == 2 { u32::MAX } else { 0 };
-    pack_state(h, w, l, cc);
-    *derived = WideDerived::new(friction_arms(h, arms), h.normal.right_perp(), h, arms, w);
+    pack_state(h, rare, w, l, cc);
+    *derived = WideDerived::new(
+        friction_arms(h, arms),
+        h.normal.right_perp(),
+        h,
+        arms,
+        w,
+        FL::new(cold.inv_det),
+    );
 }
 
 /// Copies the parts of a constraint that change during the substeps into lane `l`.
 #[super::lane_fn]
-pub(crate) fn pack_state(h: &mut WideHead, w: &mut WideContact, l: usize, cc: &ContactConstraint) {
+pub(crate) fn pack_state(h: &mut WideHead, rare: &mut WideRare, w: &mut WideContact, l: usize, cc: &ContactConstraint) {
     for i in 0..2 {
         let wp = &mut w.points[i];
         let (lam, total, max, approach, vn) = if i < cc.count {
@@ -1473,8 +1510,8 @@ pub(crate) fn pack_state(h: &mut WideHead, w: &mut WideContact, l: usize, cc: &C
         h.points[i].normal_impulse[l] = lam;
         wp.total_normal_impulse[l] = total;
         wp.max_normal_impulse[l] = max;
-        wp.approach[l] = approach;
-        h.points[i].substep_vn[l] = vn;
+        rare.approach[i][l] = approach;
+        rare.substep_vn[i][l] = vn;
     }
     let n = cc.count.min(2);
     let sum_t: f32 = cc.points[..n].iter().map(|p| p.tangent_impulse).sum();
@@ -1482,12 +1519,12 @@ pub(crate) fn pack_state(h: &mut WideHead, w: &mut WideContact, l: usize, cc: &C
     h.tangent_impulse[l] = sum_t;
     w.total_tangent_impulse[l] = sum_total_t;
     w.saturated[l] = if cc.points[0].saturated { u32::MAX } else { 0 };
-    h.rolling_impulse[l] = cc.rolling_impulse;
+    rare.rolling_impulse[l] = cc.rolling_impulse;
 }
 
 /// Copies lane `l`'s changing parts back into the scalar constraint.
 #[super::lane_fn]
-pub(crate) fn unpack_state(h: &WideHead, w: &WideContact, l: usize, cc: &mut ContactConstraint) {
+pub(crate) fn unpack_state(h: &WideHead, rare: &WideRare, w: &WideContact, l: usize, cc: &mut ContactConstraint) {
     let count = cc.count.min(2);
     let share = if count == 2 { 0.5 } else { 1.0 };
     let saturated = w.saturated.lane(l);
@@ -1497,13 +1534,13 @@ pub(crate) fn unpack_state(h: &WideHead, w: &WideContact, l: usize, cc: &mut Con
         cp.normal_impulse = h.points[i].normal_impulse[l];
         cp.total_normal_impulse = wp.total_normal_impulse[l];
         cp.max_normal_impulse = wp.max_normal_impulse[l];
-        cp.approach = wp.approach[l];
-        cp.substep_vn = h.points[i].substep_vn[l];
+        cp.approach = rare.approach[i][l];
+        cp.substep_vn = rare.substep_vn[i][l];
         cp.tangent_impulse = share * h.tangent_impulse[l];
         cp.total_tangent_impulse = share * w.total_tangent_impulse[l];
         cp.saturated = saturated;
     }
-    cc.rolling_impulse = h.rolling_impulse[l];
+    cc.rolling_impulse = rare.rolling_impulse[l];
 }
 
 /// Rebuilds the scalar constraint of lane `l` (geometry, masses and current state).
@@ -1511,6 +1548,7 @@ pub(crate) fn unpack_state(h: &WideHead, w: &WideContact, l: usize, cc: &mut Con
 pub(crate) fn unpack_full(
     h: &WideHead,
     arms: &WideArms,
+    rare: &WideRare,
     w: &WideContact,
     cold: &WideCold,
     soft: &StepSoftness,
@@ -1537,16 +1575,16 @@ pub(crate) fn unpack_full(
         mu_d: cold.mu_d[l],
         restitution: cold.restitution[l],
         restitution_threshold: cold.restitution_threshold[l],
-        rolling_resistance: w.rolling_resistance[l],
+        rolling_resistance: rare.rolling_resistance[l],
         rolling_mass: if k_roll > 0.0 { 1.0 / k_roll } else { 0.0 },
         rolling_impulse: 0.0,
-        tangent_speed: w.tangent_speed[l],
+        tangent_speed: rare.tangent_speed[l],
         k: if block {
             [w.k11[l], w.k12[l], w.k22[l]]
         } else {
             [0.0; 3]
         },
-        inv_det: if block { w.inv_det[l] } else { 0.0 },
+        inv_det: if block { cold.inv_det[l] } else { 0.0 },
         block,
         split: h.split[l],
         shift_cap2: h.shift_cap2[l],
@@ -1571,7 +1609,7 @@ pub(crate) fn unpack_full(
         cp.stick = cold.stick[i][l];
         cp.fresh = cold.fresh[i][l];
     }
-    unpack_state(h, w, l, &mut cc);
+    unpack_state(h, rare, w, l, &mut cc);
     cc
 }
 
@@ -1601,12 +1639,12 @@ mod tests {
         up: Vec2,
         ctx: &StepContext,
         states: &[S],
-    ) -> (WideHead, WideArms, WideContact, WideCold, WideDerived) {
-        let (mut h, mut arms, mut w, mut cold, mut dv) = Default::default();
+    ) -> (WideHead, WideArms, WideRare, WideContact, WideCold, WideDerived) {
+        let (mut h, mut arms, mut rare, mut w, mut cold, mut dv) = Default::default();
         lane_call!(build_group(
-            &mut h, &mut arms, &mut w, &mut cold, &mut dv, lanes, up, ctx, states
+            &mut h, &mut arms, &mut rare, &mut w, &mut cold, &mut dv, lanes, up, ctx, states
         ));
-        (h, arms, w, cold, dv)
+        (h, arms, rare, w, cold, dv)
     }
 
     fn input(count: usize, fresh: bool, restitution: f32, rolling: f32) -> ContactInput {
@@ -1727,12 +1765,12 @@ mod tests {
     fn built_as_packed(
         f: &Fixture,
         cases: &[(u32, ContactInput, ConstraintBodies)],
-    ) -> (WideHead, WideArms, WideContact, WideCold, WideDerived) {
+    ) -> (WideHead, WideArms, WideRare, WideContact, WideCold, WideDerived) {
         let (ctx, soft, states, up) = (f.ctx, f.soft, &f.states, f.up);
-        let (h, arms, w, cold, dv) = built(lanes_of(cases), up, &ctx, states);
+        let (h, arms, rare, w, cold, dv) = built(lanes_of(cases), up, &ctx, states);
         // Packed lane by lane over a copy whose ready-made part is spoilt first: pack must
         // make it again.
-        let (mut rh, mut rarms, mut r, mut rcold) = (h, arms, w, cold);
+        let (mut rh, mut rarms, mut rrare, mut r, mut rcold) = (h, arms, rare, w, cold);
         let mut rdv = WideDerived {
             i12: FL::splat(7.0),
             normal_moments: [(FL::splat(7.0), FL::splat(7.0)); 2],
@@ -1744,6 +1782,7 @@ mod tests {
             lane_call!(pack(
                 &mut rh,
                 &mut rarms,
+                &mut rrare,
                 &mut r,
                 &mut rcold,
                 &mut rdv,
@@ -1755,17 +1794,18 @@ mod tests {
         }
         assert_eq!(format!("{h:?}"), format!("{rh:?}"));
         assert_eq!(format!("{arms:?}"), format!("{rarms:?}"));
+        assert_eq!(format!("{rare:?}"), format!("{rrare:?}"));
         assert_eq!(format!("{w:?}"), format!("{r:?}"));
         assert_eq!(format!("{cold:?}"), format!("{rcold:?}"));
         assert_eq!(format!("{dv:?}"), format!("{rdv:?}"));
-        (h, arms, w, cold, dv)
+        (h, arms, rare, w, cold, dv)
     }
 
     #[test]
     fn wide_build_equals_scalar_build_and_pack() {
         let f = fixture();
         let (ctx, soft, states, up, cases) = (f.ctx, f.soft, &f.states, f.up, &f.cases);
-        let (h, arms, w, cold, dv) = built_as_packed(&f, cases);
+        let (h, arms, rare, w, cold, dv) = built_as_packed(&f, cases);
         // The ready-made part, lane by lane from the scalar build: the moments of the
         // friction row's anchors, at the middle of two points (at the point of one), K⁻¹
         // from the block's K and 1/det K (zeros, the middle one −0, where the block does
@@ -1795,7 +1835,7 @@ mod tests {
         // coefficient) comes back as the scalar build made it.
         for (l, (ci, inp, b)) in cases.iter().enumerate() {
             let cc = build_constraint(*ci, inp, b, up, &soft, &ctx, states);
-            let u = lane_call!(unpack_full(&h, &arms, &w, &cold, &soft, l));
+            let u = lane_call!(unpack_full(&h, &arms, &rare, &w, &cold, &soft, l));
             let derived = |c: &ContactConstraint| {
                 let soft: Vec<_> = c.points[..c.count].iter().map(|p| p.soft).collect();
                 format!("{:?}", (c.mu_s, c.mu_d, c.rolling_mass, c.k, c.inv_det, c.block, soft))
@@ -1821,10 +1861,10 @@ mod tests {
             h.inv_mass_b,
             h.inv_i_b,
             h.tangent_impulse,
-            h.rolling_impulse,
+            rare.rolling_impulse,
             w.mu,
-            w.tangent_speed,
-            w.rolling_resistance,
+            rare.tangent_speed,
+            rare.rolling_resistance,
             w.tangent_mass,
             w.base_drift,
         ];
@@ -1841,22 +1881,18 @@ mod tests {
     /// A group whose every field holds a value (`k` = 0 or 1: two different ones, the
     /// booleans both ways) that the build must overwrite. A full literal, no `..`: a field
     /// added to either record does not compile here until it is poisoned too.
-    fn poisoned(k: usize) -> (WideHead, WideArms, WideContact) {
+    fn poisoned(k: usize) -> (WideHead, WideArms, WideRare, WideContact) {
         let (x, flag, index) = ([7.5, -7.5][k], k == 0, [7, 9][k]);
         let x = FL::splat(x);
         let v = VL { x, y: x };
         let m = ML::new([[0x0101_0101, u32::MAX][k]; LANES]);
-        let hp = HeadPoint {
-            normal_impulse: x,
-            substep_vn: x,
-        };
+        let hp = HeadPoint { normal_impulse: x };
         let wp = WidePoint {
             base_separation: x,
             normal_mass: x,
             preload: x,
             total_normal_impulse: x,
             max_normal_impulse: x,
-            approach: x,
         };
         let head = WideHead {
             index_a: [index; LANES],
@@ -1865,6 +1901,7 @@ mod tests {
             write_b: [flag; LANES],
             any_rolling: flag,
             any_restitution: flag,
+            any_surface_speed: flag,
             normal: v,
             inv_mass_a: x,
             inv_i_a: x,
@@ -1875,17 +1912,13 @@ mod tests {
             points: [hp; 2],
             tangent_impulse: x,
             two_points: m,
-            rolling_impulse: x,
         };
         let w = WideContact {
             mu: x,
-            tangent_speed: x,
-            rolling_resistance: x,
             points: [wp; 2],
             k11: x,
             k12: x,
             k22: x,
-            inv_det: x,
             block: m,
             tangent_mass: x,
             base_drift: x,
@@ -1896,7 +1929,14 @@ mod tests {
         let arms = WideArms {
             points: [PointArms { r_a: v, r_b: v }; 2],
         };
-        (head, arms, w)
+        let rare = WideRare {
+            approach: [x; 2],
+            substep_vn: [x; 2],
+            rolling_impulse: x,
+            rolling_resistance: x,
+            tangent_speed: x,
+        };
+        (head, arms, rare, w)
     }
 
     /// The build against the scalar build and pack where no point is new (a resting pile's
@@ -1917,7 +1957,7 @@ mod tests {
             (9, one, static_with_mass),
             (12, input(2, false, 0.4, 0.05), bodies(2, 1)),
         ];
-        let (h, _, _, cold, _) = built_as_packed(&f, &cases);
+        let (h, _, _, _, cold, _) = built_as_packed(&f, &cases);
         // What the cases claim: no point is new; the first point of each lane sticks (it
         // lies at x > 0), the second of a two-point lane slides, the one-point lane's
         // absent point neither; lane 1's side A is not written back, its side B is.
@@ -1941,11 +1981,12 @@ mod tests {
                 ..f.ctx
             };
             let clean = built(f.lanes(), f.up, &ctx, &f.states);
-            let (_, _, _, mut cold, mut dv) = clean;
-            let (mut h, mut arms, mut w) = poisoned(k);
+            let (_, _, _, _, mut cold, mut dv) = clean;
+            let (mut h, mut arms, mut rare, mut w) = poisoned(k);
             lane_call!(build_group(
                 &mut h,
                 &mut arms,
+                &mut rare,
                 &mut w,
                 &mut cold,
                 &mut dv,
@@ -1955,8 +1996,8 @@ mod tests {
                 &f.states
             ));
             assert_eq!(
-                format!("{:?}", (clean.0, clean.1, clean.2)),
-                format!("{:?}", (h, arms, w)),
+                format!("{:?}", (clean.0, clean.1, clean.2, clean.3)),
+                format!("{:?}", (h, arms, rare, w)),
                 "warm {warm}, poison {k}"
             );
         }
@@ -1987,7 +2028,7 @@ mod tests {
         ] {
             let mut lanes: [LaneInput<'_>; LANES] = [None; LANES];
             lanes[lane] = Some((id, input, b));
-            let (h, _, _, cold, _) = built(lanes, f.up, &f.ctx, &f.states);
+            let (h, _, _, _, cold, _) = built(lanes, f.up, &f.ctx, &f.states);
             assert_eq!((h.any_restitution, h.any_rolling), expected, "lane {lane}");
             assert_eq!(cold.any_restitution, expected.0);
             let height = input.points[0].point.dot(f.up);
@@ -2036,12 +2077,12 @@ mod tests {
             (11, input(points, false, 0.0, 0.0), bodies(6, 7)),
         ];
         let lanes: [LaneInput<'_>; LANES] = core::array::from_fn(|l| cases.get(l).map(|c| (c.0, &c.1, &c.2)));
-        let (mut h, arms, mut w, cold, dv) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
+        let (mut h, arms, mut rare, mut w, cold, dv) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
         let d = states[7].dp - states[6].dp;
         assert!(d.length_squared() > h.shift_cap2[3], "lane 3's shift is capped");
         let built = (h, w);
         let mut scalar: Vec<ContactConstraint> = (0..cases.len())
-            .map(|l| lane_call!(unpack_full(&h, &arms, &w, &cold, &soft, l)))
+            .map(|l| lane_call!(unpack_full(&h, &arms, &rare, &w, &cold, &soft, l)))
             .collect();
         let cells = |s: &[BodyState]| -> Vec<core::cell::Cell<BodyState>> {
             s.iter().map(|&s| core::cell::Cell::new(s)).collect()
@@ -2051,15 +2092,15 @@ mod tests {
         for pass in 0..6 {
             let (bias, elapsed) = (pass % 2 == 0, (pass / 2) as f32 * ctx.h);
             if bias {
-                solve::<true, _>(&mut h, &mut w, &dv, &wide_states, &ctx, &soft, elapsed);
+                solve::<true, _>(&mut h, &mut rare, &mut w, &dv, &wide_states, &ctx, &soft, elapsed);
             } else {
-                solve::<false, _>(&mut h, &mut w, &dv, &wide_states, &ctx, &soft, elapsed);
+                solve::<false, _>(&mut h, &mut rare, &mut w, &dv, &wide_states, &ctx, &soft, elapsed);
             }
             for cc in &mut scalar {
                 crate::solver::contact_solver::solve_one(cc, &scalar_states, &ctx, bias, elapsed);
             }
             for (l, cc) in scalar.iter().enumerate() {
-                let lane = lane_call!(unpack_full(&h, &arms, &w, &cold, &soft, l));
+                let lane = lane_call!(unpack_full(&h, &arms, &rare, &w, &cold, &soft, l));
                 for (i, (p, q)) in cc.points.iter().zip(&lane.points).enumerate().take(points) {
                     let bits = |p: &ConstraintPoint| (p.normal_impulse.to_bits(), p.tangent_impulse.to_bits());
                     if tol == 0.0 {
@@ -2152,19 +2193,19 @@ mod tests {
         let face = (6u32, input(2, false, 0.0, 0.05), bodies(3, 4));
         // Warm start, biased and relax passes; then lane 0's impulses and its two bodies.
         let run = |cases: &[(u32, ContactInput, ConstraintBodies)]| {
-            let (mut h, arms, mut w, _, dv) = built(lanes_of(cases), Vec2::new(0.0, 1.0), &ctx, &states);
+            let (mut h, arms, mut rare, mut w, _, dv) = built(lanes_of(cases), Vec2::new(0.0, 1.0), &ctx, &states);
             let (two, rolling) = (h.two_points.any(), h.any_rolling);
             let cells: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
-            warm_start(&mut h, &arms, &cells);
-            solve::<true, _>(&mut h, &mut w, &dv, &cells, &ctx, &soft, ctx.h);
-            solve::<false, _>(&mut h, &mut w, &dv, &cells, &ctx, &soft, ctx.h);
+            warm_start(&h, &arms, &mut rare, &cells);
+            solve::<true, _>(&mut h, &mut rare, &mut w, &dv, &cells, &ctx, &soft, ctx.h);
+            solve::<false, _>(&mut h, &mut rare, &mut w, &dv, &cells, &ctx, &soft, ctx.h);
             // Through `Debug`, which tells −0.0 from +0.0.
             let lane = format!(
                 "{:?}",
                 (
                     h.points.map(|p| p.normal_impulse[0]),
                     h.tangent_impulse[0],
-                    h.rolling_impulse[0],
+                    rare.rolling_impulse[0],
                     w.points.map(|p| p.total_normal_impulse[0]),
                     w.total_tangent_impulse[0],
                 )
@@ -2190,9 +2231,9 @@ mod tests {
     #[test]
     fn wide_store_equals_scalar_store() {
         let f = fixture();
-        let (mut h, arms, mut w, cold, dv) = built(f.lanes(), f.up, &f.ctx, &f.states);
+        let (mut h, arms, mut rare, mut w, cold, dv) = built(f.lanes(), f.up, &f.ctx, &f.states);
         let cells: Vec<core::cell::Cell<BodyState>> = f.states.iter().map(|&s| core::cell::Cell::new(s)).collect();
-        solve::<false, _>(&mut h, &mut w, &dv, &cells, &f.ctx, &f.soft, f.ctx.h);
+        solve::<false, _>(&mut h, &mut rare, &mut w, &dv, &cells, &f.ctx, &f.soft, f.ctx.h);
         let moved: Vec<BodyState> = cells
             .iter()
             .map(|c| {
@@ -2202,11 +2243,11 @@ mod tests {
                 s
             })
             .collect();
-        let stored = lane_call!(store_group(&h, &arms, &w, &cold, &moved, &f.ctx));
+        let stored = lane_call!(store_group(&h, &arms, &rare, &w, &cold, &moved, &f.ctx));
         let out: [StoredContact; LANES] = core::array::from_fn(|l| lane_call!(stored.lane(l)));
         let (mut slipped, mut pushed) = (false, false);
         for l in 0..3 {
-            let cc = lane_call!(unpack_full(&h, &arms, &w, &cold, &f.soft, l));
+            let cc = lane_call!(unpack_full(&h, &arms, &rare, &w, &cold, &f.soft, l));
             let mut c = crate::collision::contact::blank_contact();
             let mut sums = ContactSums::default();
             store_impulses(&cc, &mut c, &mut sums, &moved, &f.ctx);
@@ -2278,14 +2319,14 @@ mod tests {
             (3, input(2, false, 0.3, 0.0), bodies(4, 5)),
         ];
         let lanes = lanes_of(&cases);
-        let (mut h, arms, mut w, mut cold, dv) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
+        let (mut h, arms, mut rare, mut w, mut cold, dv) = built(lanes, Vec2::new(0.0, 1.0), &ctx, &states);
         // Impact speeds and loads as the substeps would leave them: every point bounces but
         // lane 2's second (slower than the 1 m/s threshold); lane 1 had little energy.
         for (i, approach) in [[-3.0, -2.0, -2.5, 0.0], [-2.5, 0.0, -0.5, 0.0]]
             .into_iter()
             .enumerate()
         {
-            w.points[i].approach = lanes_from(approach);
+            rare.approach[i] = lanes_from(approach);
             w.points[i].max_normal_impulse = lanes_from([1.0, 1.0, 1.0, 0.0]);
             w.points[i].total_normal_impulse = lanes_from([0.3, 0.2, 0.1, 0.0]);
         }
@@ -2295,19 +2336,19 @@ mod tests {
         let scalar: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
         let mut expected = Vec::new();
         for l in 0..3 {
-            let mut cc = lane_call!(unpack_full(&h, &arms, &w, &cold, &soft, l));
+            let mut cc = lane_call!(unpack_full(&h, &arms, &rare, &w, &cold, &soft, l));
             restitution_one(&mut cc, &scalar);
             expected.push(cc);
         }
         let wide: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
         let before = (h, w);
-        lane_call!(restitution(&mut h, &arms, &mut w, &dv, &cold, &wide));
+        lane_call!(restitution(&mut h, &arms, &rare, &mut w, &dv, &cold, &wide));
         let bits = |s: BodyState| [s.v.x, s.v.y, s.w].map(f32::to_bits);
         for (k, (x, y)) in wide.iter().zip(&scalar).enumerate() {
             assert_eq!(bits(x.get()), bits(y.get()), "body {k}");
         }
         for (l, cc) in expected.iter().enumerate() {
-            let u = lane_call!(unpack_full(&h, &arms, &w, &cold, &soft, l));
+            let u = lane_call!(unpack_full(&h, &arms, &rare, &w, &cold, &soft, l));
             for i in 0..cc.count {
                 let f = |p: &ConstraintPoint| {
                     [p.normal_impulse, p.total_normal_impulse, p.max_normal_impulse].map(f32::to_bits)
@@ -2323,7 +2364,15 @@ mod tests {
         let (mut free_h, mut free_w, mut free_cold) = (before.0, before.1, cold);
         free_cold.kinetic_energy[1] = 1e6;
         let fresh: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
-        lane_call!(restitution(&mut free_h, &arms, &mut free_w, &dv, &free_cold, &fresh));
+        lane_call!(restitution(
+            &mut free_h,
+            &arms,
+            &rare,
+            &mut free_w,
+            &dv,
+            &free_cold,
+            &fresh
+        ));
         let lam = before.0.points[0].normal_impulse[1];
         let (capped, free) = (
             h.points[0].normal_impulse[1] - lam,

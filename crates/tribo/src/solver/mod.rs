@@ -206,13 +206,12 @@ pub(crate) trait StateCell: StateRead + Clone + Send {
         min_len: usize,
         f: impl Fn(usize, &mut T, &[Self]) + Sync + Send,
     );
-    /// [`StateCell::for_each_mut`] over two slices of the same length.
-    fn for_each_mut2<T: Send, U: Send>(
+    /// [`StateCell::for_each_mut`] over three slices of the same length.
+    fn for_each_mut3<T: Send, U: Send, V: Send>(
         states: &[Self],
-        a: &mut [T],
-        b: &mut [U],
+        slices: (&mut [T], &mut [U], &mut [V]),
         min_len: usize,
-        f: impl Fn(usize, &mut T, &mut U, &[Self]) + Sync + Send,
+        f: impl Fn(usize, &mut T, &mut U, &mut V, &[Self]) + Sync + Send,
     );
     /// Calls `f(i, states)` for `i` in `0..n` (split between threads for shared states).
     fn for_each_index(states: &[Self], n: usize, min_len: usize, f: impl Fn(usize, &[Self]) + Sync + Send);
@@ -247,15 +246,14 @@ impl StateCell for core::cell::Cell<BodyState> {
             f(i, x, states);
         }
     }
-    fn for_each_mut2<T: Send, U: Send>(
+    fn for_each_mut3<T: Send, U: Send, V: Send>(
         states: &[Self],
-        a: &mut [T],
-        b: &mut [U],
+        (a, b, c): (&mut [T], &mut [U], &mut [V]),
         _min_len: usize,
-        f: impl Fn(usize, &mut T, &mut U, &[Self]) + Sync + Send,
+        f: impl Fn(usize, &mut T, &mut U, &mut V, &[Self]) + Sync + Send,
     ) {
-        for (i, (x, y)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
-            f(i, x, y, states);
+        for (i, ((x, y), z)) in a.iter_mut().zip(b.iter_mut()).zip(c.iter_mut()).enumerate() {
+            f(i, x, y, z, states);
         }
     }
     fn for_each_index(states: &[Self], n: usize, _min_len: usize, f: impl Fn(usize, &[Self]) + Sync + Send) {
@@ -289,14 +287,19 @@ impl StateCell for SharedState {
     ) {
         for_each_mut(true, items, min_len, |i, x| f(i, x, states));
     }
-    fn for_each_mut2<T: Send, U: Send>(
+    fn for_each_mut3<T: Send, U: Send, V: Send>(
         states: &[Self],
-        a: &mut [T],
-        b: &mut [U],
+        (a, b, c): (&mut [T], &mut [U], &mut [V]),
         min_len: usize,
-        f: impl Fn(usize, &mut T, &mut U, &[Self]) + Sync + Send,
+        f: impl Fn(usize, &mut T, &mut U, &mut V, &[Self]) + Sync + Send,
     ) {
-        for_each_mut2(true, a, b, min_len, |i, x, y| f(i, x, y, states));
+        let n = min_len.max(1);
+        let chunks = a.chunks_mut(n).zip(b.chunks_mut(n)).zip(c.chunks_mut(n)).enumerate();
+        claim_each(true, chunks, |(k, ((xs, ys), zs))| {
+            for (j, ((x, y), z)) in xs.iter_mut().zip(ys.iter_mut()).zip(zs.iter_mut()).enumerate() {
+                f(k * n + j, x, y, z, states);
+            }
+        });
     }
     fn for_each_index(states: &[Self], n: usize, min_len: usize, f: impl Fn(usize, &[Self]) + Sync + Send) {
         let len = min_len.max(1);
@@ -804,7 +807,7 @@ pub(crate) fn for_each_mut2<A: Send, B: Send>(
 }
 
 /// Mutable slices cut together into chunks ([`for_each_chunk_mut`]): a tuple of
-/// `&mut [T]`, of four or five element types.
+/// `&mut [T]`, of three to six element types.
 pub(crate) trait SliceTuple: Sized + Send {
     /// The shortest slice's length (the slices are meant to have one length).
     fn len(&self) -> usize;
@@ -829,8 +832,10 @@ macro_rules! slice_tuple {
         }
     };
 }
+slice_tuple!(A a, B b, C c);
 slice_tuple!(A a, B b, C c, D d);
 slice_tuple!(A a, B b, C c, D d, E e);
+slice_tuple!(A a, B b, C c, D d, E e, F f);
 
 /// [`for_each_mut`] over a tuple of slices by chunks of `min_len`: `f(first, chunks)` gets
 /// a chunk of each slice (its first element at index `first`), so it can look ahead inside
