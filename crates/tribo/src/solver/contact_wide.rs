@@ -13,12 +13,15 @@
 //!   colour, so each pass solves them last (the ground has the last word, as in Box2D).
 //!   A constraint that finds no colour goes to the overflow list, solved by the scalar code
 //!   before the coloured work of each pass.
-//! * **Wide layout**: four constraints as structure-of-arrays ([`FL`] lanes), in four
-//!   arrays by use: [`WideHead`] (bodies, normal, masses, anchors, impulses: all the warm
-//!   start reads, so it streams ~400 bytes per group, not 1 KiB), [`WideContact`] (the
-//!   rest the solve passes read), [`WideDerived`] (what the solve passes would derive again
-//!   in every pass, made once a step) and [`WideCold`] (what only build, restitution and
-//!   store read). Every lane has two points; a one-point manifold has a second point
+//! * **Wide layout**: four constraints as structure-of-arrays ([`FL`] lanes), in six
+//!   arrays by use: [`WideHead`] (bodies, normal, masses, impulses: what every pass
+//!   reads), [`WideArms`] (the points' anchors: the warm start, restitution and the store),
+//!   [`WideContact`] (the rest the solve passes read), [`WideDerived`] (what the solve
+//!   passes would derive again in every pass, made once a step), [`WideRare`] (what only
+//!   groups with restitution, rolling resistance or a surface speed use, touched by the
+//!   passes only there) and [`WideCold`] (what only build, restitution and store read).
+//!   The passes are bound by the bytes they stream in large scenes (large_pyramid's groups
+//!   are megabytes, beyond L2): each streams only the arrays it reads. Every lane has two points; a one-point manifold has a second point
 //!   with zero mass, anchors and impulses, which then changes nothing. Friction is one
 //!   row per lane: the patch row at the middle of a two-point manifold, or the point row
 //!   of a one-point manifold (the same row with one point). Empty lanes of the last group
@@ -66,9 +69,9 @@ pub(crate) struct HeadPoint {
     pub normal_impulse: FL,
 }
 
-/// The part of four constraints the warm start needs (bodies, normal, masses, anchors,
-/// impulses), kept in its own array: the warm start streams only these ~400 bytes per
-/// group instead of the whole constraint (it is bound by memory traffic, not arithmetic).
+/// The part of four constraints every pass reads (bodies, normal, masses, impulses), kept
+/// in its own array: with [`WideArms`] all the warm start streams (it is bound by memory
+/// traffic, not arithmetic), 480 bytes a group of eight lanes.
 ///
 /// [`build_group`] writes every field, with no clearing first (as for [`WideContact`]): a
 /// field added here must be written there, and poisoned in the test `build_writes_every_field`
@@ -153,8 +156,9 @@ pub(crate) struct WideRare {
 /// a side is static), 1/k11 and 1/k22 (the points' normal masses where the block applies)
 /// and the rolling mass (from the inverse inertias) are derived where they are used; K⁻¹,
 /// the moments of the friction row's anchors and those of each point's anchors about the
-/// normal, which every pass would derive, are in the group's [`WideDerived`]. 400 bytes
-/// (was 608). [`build_group`] writes every field (see [`WideHead`]).
+/// normal, which every pass would derive, are in the group's [`WideDerived`]; what only
+/// some groups use is in [`WideRare`]. 320 bytes with four lanes (was 608).
+/// [`build_group`] writes every field (see [`WideHead`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WideContact {
     /// Friction coefficient of the row this step: μs where it sticks, μd where it slides.
@@ -240,7 +244,8 @@ impl WideDerived {
 }
 
 // What the hot passes stream per group of four constraints (bytes).
-// (In vectors of lanes: 144, 400 and 416 bytes with four lanes, twice that with eight.)
+// (In vectors of lanes: 144, 320 and 240 bytes with four lanes, twice that with eight;
+// the warm start's anchors 128, the rare part 112.)
 const VECTOR: usize = core::mem::size_of::<FL>();
 const _: () = assert!(core::mem::size_of::<WideDerived>() == 9 * VECTOR);
 const _: () = assert!(core::mem::size_of::<WideContact>() == 20 * VECTOR);
