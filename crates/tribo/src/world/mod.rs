@@ -1065,7 +1065,7 @@ impl World {
         };
         let check = check && dt > 0.0 && b.body_type == BodyType::Dynamic;
         let (xf, v) = (b.xf, box_velocity(b, self.def.max_linear_speed));
-        let moved = (b.center - b.center0).length();
+        let moved = Moved(b.center - b.center0);
         for k in first..b.shapes.len() {
             // Every listed shape is live.
             let index = b.shape_index(k);
@@ -1340,12 +1340,23 @@ pub(crate) fn shape_box(geometry: &Shape, xf: Transform, v: Vec2, dt: f32, free:
 /// the world's speed limit; a velocity above it (left by the last pass of a violent step)
 /// must not sweep a box across the world, which would pair it with every shape.
 pub(crate) fn box_velocity(b: &Body, limit: f32) -> Vec2 {
-    let speed = b.v.length();
-    if speed > limit {
-        b.v * (limit / speed)
-    } else {
-        b.v
+    // Well under the limit (the common case) without the square root and the division.
+    if !exceeds(b.v.length_squared(), || b.v.length(), limit) {
+        return b.v;
     }
+    b.v * (limit / b.v.length())
+}
+
+/// Whether a length is beyond `bound` [m or m/s]: `exact() > bound`, where `exact` is the
+/// length as the caller computes it and `squared` its square (what it is computed from,
+/// up to roundings). Where the square is under 0.999 `bound`², a margin far wider than
+/// those roundings, the length is surely not beyond and is not computed: the finalize
+/// asked for six square roots and two divisions a body, whose latency was most of
+/// `refresh_boxes`' samples in large_pyramid. Elsewhere the length is computed and
+/// compared as it always was, so the answer is the same to the bit.
+#[inline(always)]
+pub(crate) fn exceeds(squared: f32, exact: impl FnOnce() -> f32, bound: f32) -> bool {
+    !(squared < 0.999 * (bound * bound)) && exact() > bound
 }
 
 /// A shape's box for the next step from `tight`, its box at the body's new pose (swept
@@ -1366,12 +1377,12 @@ pub(crate) fn next_box(
     dt: f32,
     check: bool,
     sweep: bool,
-    moved: f32,
+    moved: Moved,
 ) -> Option<Aabb> {
     if check && !s.fat_aabb.expand(SPECULATIVE_DISTANCE + LINEAR_SLOP).contains(tight) {
         return None;
     }
-    if check && sweep && moved > s.sweep_free {
+    if check && sweep && moved.beyond(s.sweep_free) {
         return None;
     }
     Some(swept_box(
@@ -1382,11 +1393,25 @@ pub(crate) fn next_box(
     ))
 }
 
+/// The displacement of a body's centre over the step [m] (its length is computed only
+/// where it is compared near a bound: [`exceeds`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Moved(pub Vec2);
+
+impl Moved {
+    /// Whether the displacement is longer than `bound` [m].
+    #[inline(always)]
+    pub(crate) fn beyond(self, bound: f32) -> bool {
+        exceeds(self.0.length_squared(), || self.0.length(), bound)
+    }
+}
+
 /// [`shape_box`] from the shape's tight box at its pose.
 fn swept_box(tight: Aabb, v: Vec2, dt: f32, free: f32) -> Aabb {
     let aabb = tight.expand(SPECULATIVE_DISTANCE);
-    let motion = v.length() * dt;
-    if dt > 0.0 && motion > free.max(SPECULATIVE_DISTANCE) {
+    let reach = free.max(SPECULATIVE_DISTANCE);
+    if dt > 0.0 && exceeds(v.length_squared() * (dt * dt), || v.length() * dt, reach) {
+        let motion = v.length() * dt;
         let d = v * (dt * (1.0 - SPECULATIVE_DISTANCE / motion));
         aabb.union(Aabb::new(aabb.min + d, aabb.max + d))
     } else {

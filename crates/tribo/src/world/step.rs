@@ -22,7 +22,7 @@ use crate::solver::{
     SolverBody, StepConstraints, StepContext,
 };
 use crate::world::Arena;
-use crate::world::{box_velocity, next_box};
+use crate::world::{box_velocity, exceeds, next_box, Moved};
 use crate::world::{BodyId, ShapeId};
 
 impl World {
@@ -1113,7 +1113,7 @@ impl World {
                     }
                     let check = b.body_type == BodyType::Dynamic;
                     let sweep = b.bullet || !touched[k];
-                    let moved = (b.center - b.center0).length();
+                    let moved = Moved(b.center - b.center0);
                     let next = next_box(
                         s,
                         s.geometry.aabb(b.xf),
@@ -1620,8 +1620,9 @@ fn rests(b: &Body, tts: f32) -> bool {
 /// next box is not swept whatever the rule ([`next_box`]: the sweep starts beyond
 /// `sweep_free`, which is at least that distance, and so does the check of a swept body).
 fn boxes_care(b: &Body, dt: f32, limit: f32) -> bool {
-    box_velocity(b, limit).length() * dt > SPECULATIVE_DISTANCE
-        || (b.center - b.center0).length() > SPECULATIVE_DISTANCE
+    let v = box_velocity(b, limit);
+    exceeds(v.length_squared() * (dt * dt), || v.length() * dt, SPECULATIVE_DISTANCE)
+        || Moved(b.center - b.center0).beyond(SPECULATIVE_DISTANCE)
 }
 
 /// How many solver slots ahead [`World::finalize`] asks for the body records.
