@@ -8,8 +8,9 @@
 //!    moving pairs take the lowest free colour, pairs with a static or kinematic side the
 //!    highest, so each pass solves them last, as Box2D v3's `constraint_graph.c` does; no
 //!    free colour → overflow;
-//! 2. lay the colours out as runs of groups of four lanes ([`WideHead`] + [`WideContact`]
-//!    + [`WideCold`]); inside a colour, face contacts whose two points both carried load
+//! 2. lay the colours out as runs of groups of four lanes (six arrays by use:
+//!    [`WideHead`], [`WideArms`], [`WideRare`], [`WideContact`], [`WideCold`],
+//!    [`WideDerived`]); inside a colour, face contacts whose two points both carried load
 //!    go first (they will most likely take the 2×2 block's fast path together);
 //! 3. build the groups four lanes at a time ([`contact_wide::build_group`]), or keep a
 //!    constraint whole in the overflow list ([`build_constraint`]).
@@ -76,7 +77,7 @@ pub(crate) struct ContactSolver {
     pub up: Vec2,
     /// The contact softnesses of the step (the lanes pick theirs in the solve).
     soft: StepSoftness,
-    /// What the warm start reads of each group (parallel to `wide`).
+    /// What every pass reads of each group (parallel to `wide`).
     head: Vec<WideHead>,
     wide: Vec<WideContact>,
     cold: Vec<WideCold>,
@@ -1501,6 +1502,8 @@ impl ContactSolver {
         for parts in &cuts {
             let mut out = Vec::with_capacity(parts.len());
             for at in parts {
+                // (`team_cuts` makes ascending cuts from `taken` on.)
+                debug_assert!(at[0] >= taken && at.windows(2).all(|w| w[0] <= w[1]));
                 let skip = at[0].saturating_sub(taken);
                 written = written.split_at(skip).1;
                 (arms, derived) = (arms.get(skip..).unwrap_or(&[]), derived.get(skip..).unwrap_or(&[]));

@@ -21,8 +21,9 @@
 //!   groups with restitution, rolling resistance or a surface speed use, touched by the
 //!   passes only there) and [`WideCold`] (what only build, restitution and store read).
 //!   The passes are bound by the bytes they stream in large scenes (large_pyramid's groups
-//!   are megabytes, beyond L2): each streams only the arrays it reads. Every lane has two points; a one-point manifold has a second point
-//!   with zero mass, anchors and impulses, which then changes nothing. Friction is one
+//!   are megabytes, beyond L2): each streams only the arrays it reads. Every lane has two
+//!   points; a one-point manifold has a second point with zero mass, anchors and
+//!   impulses, which then changes nothing. Friction is one
 //!   row per lane: the patch row at the middle of a two-point manifold, or the point row
 //!   of a one-point manifold (the same row with one point). Empty lanes of the last group
 //!   of a colour use the static body (index 0) on both sides and zero masses.
@@ -62,16 +63,17 @@ pub(crate) struct WidePoint {
     pub max_normal_impulse: FL,
 }
 
-/// One point of four constraints: what the warm start reads and writes and the solve
-/// passes read too (its anchors are in [`WideArms`]).
+/// One point of four constraints: what the warm start reads and the solve passes and
+/// restitution read and write (its anchors are in [`WideArms`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct HeadPoint {
     pub normal_impulse: FL,
 }
 
 /// The part of four constraints every pass reads (bodies, normal, masses, impulses), kept
-/// in its own array: with [`WideArms`] all the warm start streams (it is bound by memory
-/// traffic, not arithmetic), 480 bytes a group of eight lanes.
+/// in its own array: with [`WideArms`] all the warm start streams but in groups with
+/// restitution or rolling resistance (it is bound by memory traffic, not arithmetic), 480
+/// bytes a group of eight lanes.
 ///
 /// [`build_group`] writes every field, with no clearing first (as for [`WideContact`]): a
 /// field added here must be written there, and poisoned in the test `build_writes_every_field`
@@ -118,7 +120,7 @@ pub(crate) struct PointArms {
 /// store read, but not the solve passes (they read the anchors' moments in
 /// [`WideDerived`]). In an array of their own, not in [`WideHead`]: the solve and relax
 /// passes stream their groups from beyond the L2 cache in large scenes (large_pyramid's
-/// 1 873 groups are 3.6 MB), and lines they do not read but that lie among those they do
+/// 1 873 groups were 3.6 MB with the anchors, 2.6 MB now), and lines they do not read but that lie among those they do
 /// are streamed as well (256 unread bytes added to each [`WideContact`] made
 /// large_pyramid's solve and relax 9–10 % slower). Written by the build and [`pack`] only.
 #[derive(Clone, Copy, Debug, Default)]
@@ -130,8 +132,9 @@ pub(crate) struct WideArms {
 /// surface speed. In an array of its own (as [`WideArms`]): the passes touch a group's
 /// only where its flags say the group uses it ([`WideHead::any_restitution`],
 /// `any_rolling`, `any_surface_speed`), so the groups without them do not stream these
-/// 224 bytes (8 lanes) in every pass. The build, [`pack`] and the store read or write all
-/// of it.
+/// 224 bytes (8 lanes) in every pass. The build and [`pack`] write all of it, the unpacks
+/// read all of it, the store reads the approach speeds, the rolling impulse and the
+/// surface speed.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WideRare {
     /// `ConstraintPoint::approach` of each point, tracked only in groups with restitution
@@ -157,7 +160,8 @@ pub(crate) struct WideRare {
 /// and the rolling mass (from the inverse inertias) are derived where they are used; K⁻¹,
 /// the moments of the friction row's anchors and those of each point's anchors about the
 /// normal, which every pass would derive, are in the group's [`WideDerived`]; what only
-/// some groups use is in [`WideRare`]. 320 bytes with four lanes (was 608).
+/// some groups use is in [`WideRare`]. 320 bytes with four lanes (was 400, and 608 before
+/// that).
 /// [`build_group`] writes every field (see [`WideHead`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WideContact {
@@ -199,14 +203,15 @@ pub(crate) struct WideCold {
     pub any_restitution: bool,
 }
 
-/// What every pass of a step would derive again from a group's [`WideHead`] and
-/// [`WideContact`], made once a step ([`WideDerived::new`]) and kept in an array of its own: the
-/// moments of the friction row's anchors and of each point's anchors about the normal, and
-/// K⁻¹ = [k22, −k12; −k12, k11] / det K (zero where the block does not apply). Only the
-/// passes and restitution read it; the build (or [`pack`]) writes it and the store does not
-/// touch it, so the store does not stream it with the groups. (Kept inside [`WideContact`] it
-/// made large_pyramid's step 2.5 % faster but many_pyramids' 3 % slower: its build and
-/// store streamed the bigger records.)
+/// What every pass of a step would derive again from a group's [`WideHead`], [`WideArms`]
+/// and [`WideContact`] (and 1/det K, in [`WideCold`]), made once a step
+/// ([`WideDerived::new`]) and kept in an array of its own: the moments of the friction
+/// row's anchors and of each point's anchors about the normal, and K⁻¹ = [k22, −k12; −k12,
+/// k11] / det K (zero where the block does not apply). Only the passes and restitution read
+/// it; the build (or [`pack`]) writes it and the store does not touch it, so the store does
+/// not stream it with the groups. (Kept inside [`WideContact`] it made large_pyramid's step
+/// 2.5 % faster but many_pyramids' 3 % slower: its build and store streamed the bigger
+/// records.)
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WideDerived {
     /// The friction row's anchors' moments about the tangent t = (n.y, −n.x),
@@ -224,9 +229,9 @@ pub(crate) struct WideDerived {
 }
 
 impl WideDerived {
-    /// From the group's friction anchors ([`friction_arms`]), tangent `t`, its points'
-    /// anchors and normal (in `h`) and its K and 1/det K: the expressions the passes
-    /// evaluated each time, so the same bits.
+    /// From the group's friction anchors ([`friction_arms`]), tangent `t`, its normal (in
+    /// `h`), its points' anchors (`arms`), its K (in `w`) and 1/det K (`inv_det`): the
+    /// expressions the passes evaluated each time, so the same bits.
     #[inline(always)]
     fn new(friction: (VL, VL), t: VL, h: &WideHead, arms: &WideArms, w: &WideContact, inv_det: FL) -> WideDerived {
         WideDerived {
@@ -933,7 +938,7 @@ pub(crate) fn build_group<S: StateRead>(
     let one = FL::splat(1.0);
     let half = FL::splat(0.5);
     // Written in place (a 1 KiB group built on the stack and copied costs more), every
-    // field of `head` and `w` once, with no clearing first: clearing them was two
+    // field of `head`, `anchors`, `rare` and `w` once, with no clearing first: clearing them was two
     // `memset` calls a group, 84 instructions of large_pyramid's ~1 200 (the test
     // `build_writes_every_field` builds into a poisoned group). `cold` is cleared.
     *cold = WideCold::default();
@@ -1885,7 +1890,7 @@ mod tests {
 
     /// A group whose every field holds a value (`k` = 0 or 1: two different ones, the
     /// booleans both ways) that the build must overwrite. A full literal, no `..`: a field
-    /// added to either record does not compile here until it is poisoned too.
+    /// added to any of the four records does not compile here until it is poisoned too.
     fn poisoned(k: usize) -> (WideHead, WideArms, WideRare, WideContact) {
         let (x, flag, index) = ([7.5, -7.5][k], k == 0, [7, 9][k]);
         let x = FL::splat(x);

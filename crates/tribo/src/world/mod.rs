@@ -1347,7 +1347,7 @@ pub(crate) fn box_velocity(b: &Body, limit: f32) -> Vec2 {
     b.v * (limit / b.v.length())
 }
 
-/// Whether a length is beyond `bound` [m or m/s]: `exact() > bound`, where `exact` is the
+/// Whether a length is beyond `bound` (≥ 0) [m or m/s]: `exact() > bound`, where `exact` is the
 /// length as the caller computes it and `squared` its square (what it is computed from,
 /// up to roundings). Where the square is under 0.999 `bound`², a margin far wider than
 /// those roundings, the length is surely not beyond and is not computed: the finalize
@@ -1356,8 +1356,12 @@ pub(crate) fn box_velocity(b: &Body, limit: f32) -> Vec2 {
 /// compared as it always was, so the answer is the same to the bit.
 #[inline(always)]
 pub(crate) fn exceeds(squared: f32, exact: impl FnOnce() -> f32, bound: f32) -> bool {
-    // (A NaN square is not surely small: the length is computed and compared.)
-    let surely_small = squared < 0.999 * (bound * bound);
+    debug_assert!(bound >= 0.0 || bound.is_nan(), "a length's bound is not negative");
+    // (A NaN square is not surely small: the length is computed and compared. The bound's
+    // square is capped at the largest float: an overflowing one would take every finite
+    // square for surely small, while a length scaled apart from its square (`swept_box`)
+    // may still be just over a bound that large.)
+    let surely_small = squared < 0.999 * (bound * bound).min(f32::MAX);
     !surely_small && exact() > bound
 }
 
@@ -1472,11 +1476,13 @@ mod tests {
     use crate::geometry::Polygon;
     use crate::solver::with_contacts;
 
-    /// `exceeds` answers exactly as the plain comparison `v.length() > bound` it stands for,
-    /// for lengths on both sides of the bound and within ulps of it (where the squared
-    /// test must defer to the length), at zero, and for infinite and NaN components.
-    /// Checked by mutation: with the margin 0.999 raised to 1.01 it fails (a length 0.3 %
-    /// over the bound would be taken as surely under it).
+    /// `exceeds` answers exactly as the plain comparison it stands for (`v.length() > bound`,
+    /// and `v.length() * dt > bound` as the finalize scales it), for lengths on both sides of
+    /// the bound and within ulps of it (where the squared test must defer to the length), at
+    /// zero, for infinite and NaN components, a subnormal step squared and an infinite
+    /// bound. Checked by mutation: with the margin 0.999 raised to 1.01 it fails (a length
+    /// 0.3 % over the bound would be taken as surely under it); at 1.0 it still passes (the
+    /// roundings of these cases stay far inside the margin).
     #[test]
     fn exceeds_agrees_with_the_length_comparison() {
         let bound = 0.02f32;
@@ -1511,13 +1517,49 @@ mod tests {
             Vec2::new(-f32::INFINITY, f32::INFINITY),
         ]);
         let mut near = 0;
-        for v in cases {
+        for &v in &cases {
             let plain = v.length() > bound;
             assert_eq!(exceeds(v.length_squared(), || v.length(), bound), plain, "{v:?}");
             assert_eq!(Moved(v).beyond(bound), plain, "{v:?}");
             near += usize::from((v.length() - bound).abs() < 1e-6);
         }
         assert!(near > 100, "the cases reach the bound's ulps ({near})");
+        // The forms scaled by the step (`swept_box`, `boxes_care`), where the square and the
+        // length are rounded apart: speeds ulp by ulp across bound / dt, for steps of a
+        // game, a long one and one whose square is subnormal; and an infinite bound (a box
+        // that is not swept) and one whose square overflows.
+        let dirs = [Vec2::new(1.0, 0.0), Vec2::new(0.6, 0.8), Vec2::new(0.28, -0.96)];
+        let mut flips = 0;
+        for (dt, bound) in [
+            (1.0f32 / 60.0, bound),
+            (1.0 / 240.0, bound),
+            (0.37, bound),
+            (3e-21, bound),
+            (0.5, 3e19),
+        ] {
+            let mut speed = bound / dt;
+            for _ in 0..64 {
+                speed = f32::from_bits(speed.to_bits() - 1);
+            }
+            for _ in 0..128 {
+                for dir in dirs {
+                    let v = dir * speed;
+                    let plain = v.length() * dt > bound;
+                    let fast = exceeds(v.length_squared() * (dt * dt), || v.length() * dt, bound);
+                    assert_eq!(fast, plain, "{v:?}, dt {dt}, bound {bound}");
+                    flips += usize::from(plain);
+                }
+                speed = f32::from_bits(speed.to_bits() + 1);
+            }
+        }
+        assert!(flips > 0 && flips < 5 * 128 * 3, "both answers occur ({flips})");
+        for v in cases {
+            let plain = v.length() * 0.5 > f32::INFINITY;
+            assert_eq!(
+                exceeds(v.length_squared() * 0.25, || v.length() * 0.5, f32::INFINITY),
+                plain
+            );
+        }
     }
 
     fn square() -> Shape {
