@@ -1341,10 +1341,10 @@ pub(crate) fn shape_box(geometry: &Shape, xf: Transform, v: Vec2, dt: f32, free:
 /// must not sweep a box across the world, which would pair it with every shape.
 pub(crate) fn box_velocity(b: &Body, limit: f32) -> Vec2 {
     // Well under the limit (the common case) without the square root and the division.
-    if !exceeds(b.v.length_squared(), || b.v.length(), limit) {
-        return b.v;
+    match length_beyond(b.v.length_squared(), || b.v.length(), limit) {
+        Some(speed) => b.v * (limit / speed),
+        None => b.v,
     }
-    b.v * (limit / b.v.length())
 }
 
 /// Whether a length is beyond `bound` (≥ 0) [m or m/s]: `exact() > bound`, where `exact` is the
@@ -1356,13 +1356,23 @@ pub(crate) fn box_velocity(b: &Body, limit: f32) -> Vec2 {
 /// compared as it always was, so the answer is the same to the bit.
 #[inline(always)]
 pub(crate) fn exceeds(squared: f32, exact: impl FnOnce() -> f32, bound: f32) -> bool {
+    length_beyond(squared, exact, bound).is_some()
+}
+
+/// [`exceeds`], giving the length where it is beyond the bound (for the callers that use it
+/// then, without computing it again).
+#[inline(always)]
+fn length_beyond(squared: f32, exact: impl FnOnce() -> f32, bound: f32) -> Option<f32> {
     debug_assert!(bound >= 0.0 || bound.is_nan(), "a length's bound is not negative");
     // (A NaN square is not surely small: the length is computed and compared. The bound's
     // square is capped at the largest float: an overflowing one would take every finite
     // square for surely small, while a length scaled apart from its square (`swept_box`)
     // may still be just over a bound that large.)
     let surely_small = squared < 0.999 * (bound * bound).min(f32::MAX);
-    !surely_small && exact() > bound
+    if surely_small {
+        return None;
+    }
+    Some(exact()).filter(|&length| length > bound)
 }
 
 /// A shape's box for the next step from `tight`, its box at the body's new pose (swept
@@ -1416,8 +1426,8 @@ impl Moved {
 fn swept_box(tight: Aabb, v: Vec2, dt: f32, free: f32) -> Aabb {
     let aabb = tight.expand(SPECULATIVE_DISTANCE);
     let reach = free.max(SPECULATIVE_DISTANCE);
-    if dt > 0.0 && exceeds(v.length_squared() * (dt * dt), || v.length() * dt, reach) {
-        let motion = v.length() * dt;
+    let beyond = |dt: f32| length_beyond(v.length_squared() * (dt * dt), || v.length() * dt, reach);
+    if let Some(motion) = if dt > 0.0 { beyond(dt) } else { None } {
         let d = v * (dt * (1.0 - SPECULATIVE_DISTANCE / motion));
         aabb.union(Aabb::new(aabb.min + d, aabb.max + d))
     } else {
