@@ -43,12 +43,11 @@ impl EngineKind {
     /// How the engine's contact solver was built for this run (the JSON's `simd`).
     pub fn simd(self) -> &'static str {
         match self {
-            EngineKind::Tribo | EngineKind::TriboMus15
-                if tribo_lanes() == tribo::SolverLanes::Auto && tribo::solver_lanes() == 8 =>
-            {
-                "avx2-8"
-            }
-            EngineKind::Tribo | EngineKind::TriboMus15 => "sse2-4",
+            EngineKind::Tribo | EngineKind::TriboMus15 => match (tribo_lanes(), tribo::solver_instructions()) {
+                (tribo::SolverLanes::Auto, "AVX-512VL") => "avx512vl-8",
+                (tribo::SolverLanes::Auto | tribo::SolverLanes::Eight, "AVX2" | "AVX-512VL") => "avx2-8",
+                _ => "sse2-4",
+            },
             EngineKind::Box2d if cfg!(feature = "box2d-avx2") => "avx2-8",
             EngineKind::Box2d => "sse2-4",
             // rapier2d's default features (no `simd8`); compiled for AVX2 when the whole
@@ -60,13 +59,16 @@ impl EngineKind {
 }
 
 /// The wide solver Tribo's worlds run: [`tribo::SolverLanes::Auto`] (eight lanes on a CPU
-/// with AVX2), or four with `TRIBO_BENCH_LANES=4` (to time the SSE2 solver on such a CPU).
+/// with AVX2, compiled for AVX-512VL where it has that too), eight compiled for AVX2 only
+/// with `TRIBO_BENCH_LANES=8`, or four with `TRIBO_BENCH_LANES=4` (to time those builds on
+/// such a CPU).
 pub fn tribo_lanes() -> tribo::SolverLanes {
     match std::env::var("TRIBO_BENCH_LANES").as_deref() {
         Ok("4") => tribo::SolverLanes::Four,
+        Ok("8") => tribo::SolverLanes::Eight,
         Ok("") | Ok("auto") | Err(_) => tribo::SolverLanes::Auto,
         Ok(other) => {
-            eprintln!("TRIBO_BENCH_LANES={other:?}: not 4 or auto; taking auto");
+            eprintln!("TRIBO_BENCH_LANES={other:?}: not 4, 8 or auto; taking auto");
             tribo::SolverLanes::Auto
         }
     }

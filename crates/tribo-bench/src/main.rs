@@ -282,6 +282,10 @@ fn print_header(args: &Args) {
             "Tribo {} on this CPU; here worlds with SolverLanes::Four: 4 lanes (TRIBO_BENCH_LANES=4)",
             tribo::build_info()
         ),
+        tribo::SolverLanes::Eight => println!(
+            "Tribo {} on this CPU; here worlds with SolverLanes::Eight: 8 lanes, AVX2 only (TRIBO_BENCH_LANES=8)",
+            tribo::build_info()
+        ),
         _ => println!("Tribo {}", tribo::build_info()),
     }
     println!(

@@ -30,8 +30,11 @@ struct Cli {
 /// `--solver-lanes` (`tribo::SolverLanes`).
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum Lanes {
-    /// Eight lanes (AVX2) if the CPU has AVX2, else four.
+    /// Eight lanes if the CPU has AVX2 (compiled for AVX-512VL if it has that too), else four.
     Auto,
+    /// Eight lanes compiled for AVX2 only, even on a CPU with AVX-512 (four without AVX2).
+    #[value(name = "8")]
+    Eight,
     /// Four lanes (SSE2 on x86-64).
     #[value(name = "4")]
     Four,
@@ -75,8 +78,9 @@ pub struct RunArgs {
     /// Worker threads for each step (1..=256; results are identical for every count).
     #[arg(long, default_value_t = 1)]
     pub threads: u32,
-    /// Contact constraints the solver handles at once: `auto` (8 with AVX2, else 4) or `4`
-    /// (results are identical either way; `tribo --version` shows what `auto` takes).
+    /// Contact constraints the solver handles at once: `auto` (8 with AVX2, compiled for
+    /// AVX-512VL where the CPU has it, else 4), `8` (AVX2 only) or `4` (results are
+    /// identical every way; `tribo --version` shows what `auto` takes).
     #[arg(long, value_enum, default_value_t = Lanes::Auto)]
     pub solver_lanes: Lanes,
     /// Trajectory output: .csv or .jsonl.
@@ -200,6 +204,7 @@ fn run(args: &RunArgs) -> Result<(), String> {
         workers: args.threads,
         solver_lanes: match args.solver_lanes {
             Lanes::Auto => tribo::SolverLanes::Auto,
+            Lanes::Eight => tribo::SolverLanes::Eight,
             Lanes::Four => tribo::SolverLanes::Four,
         },
         ..*built.world.def()
@@ -234,7 +239,7 @@ fn run(args: &RunArgs) -> Result<(), String> {
         0.0
     };
     eprintln!(
-        "{}: {} steps of {:.4} s, {} bodies, {} contacts at the end, {:.3} ms/step ({:.2} s; solver: {} lanes)",
+        "{}: {} steps of {:.4} s, {} bodies, {} contacts at the end, {:.3} ms/step ({:.2} s; solver: {} lanes, {})",
         args.scene,
         scene.steps,
         scene.dt,
@@ -242,7 +247,8 @@ fn run(args: &RunArgs) -> Result<(), String> {
         sim.built.world.contacts().count(),
         per_step,
         elapsed,
-        sim.built.world.solver_lanes()
+        sim.built.world.solver_lanes(),
+        sim.built.world.solver_instructions()
     );
     Ok(())
 }

@@ -1,13 +1,15 @@
-//! Attributes for the two builds of Tribo's wide contact solver in one binary.
+//! Attributes for the three builds of Tribo's wide contact solver in one binary.
 //!
-//! The solver's source (`tribo::solver::contact_set` and `contact_wide`) is compiled twice,
-//! once as the four-lane solver (SSE2, the x86-64 baseline) and once as the eight-lane one
-//! (AVX2), and the world picks one at run time. The source marks its functions with
-//! `#[super::lane_fn]` (and its test modules with `#[super::lane_tests]`); each build's
-//! parent module re-exports these attributes under those names: the four-lane build the
-//! `keep` ones (the item unchanged), the eight-lane build the `avx2` ones, so one text gives
-//! two sets of functions, the second compiled for AVX2 (`#[target_feature(enable =
-//! "avx2")]`, which their closures inherit).
+//! The solver's source (`tribo::solver::contact_set` and `contact_wide`) is compiled three
+//! times on x86-64: as the four-lane solver (SSE2, the x86-64 baseline), as the eight-lane
+//! one (AVX2), and as the eight-lane one again with AVX-512VL (the same 256-bit vectors,
+//! with 32 registers instead of 16), and the world picks one at run time. The source marks
+//! its functions with `#[super::lane_fn]` (and its test modules with
+//! `#[super::lane_tests]`); each build's parent module re-exports these attributes under
+//! those names: the four-lane build the `keep` ones (the item unchanged), the eight-lane
+//! builds the `avx2` or `avx512` ones, so one text gives three sets of functions, the
+//! others compiled for AVX2 (`#[target_feature(enable = "avx2")]`, which their closures
+//! inherit) or for AVX-512VL.
 //!
 //! No dependency: an attribute here only puts attributes in front of the item's tokens.
 
@@ -43,6 +45,26 @@ pub fn avx2(_args: TokenStream, item: TokenStream) -> TokenStream {
 #[proc_macro_attribute]
 pub fn avx2_inline(_args: TokenStream, item: TokenStream) -> TokenStream {
     prefixed("#[inline(always)]", item)
+}
+
+/// The function compiled for AVX2 and AVX-512F/VL (the AVX-512 eight-lane build's
+/// `lane_fn`): the same eight-lane code, which the compiler may now keep in 32 vector
+/// registers instead of 16 (the solve passes' spills) and write with AVX-512VL's 256-bit
+/// instructions. Calling it from code not compiled for these is `unsafe`: the caller must
+/// know the CPU has them.
+#[proc_macro_attribute]
+pub fn avx512(_args: TokenStream, item: TokenStream) -> TokenStream {
+    prefixed("#[target_feature(enable = \"avx2,avx512f,avx512vl\")]", item)
+}
+
+/// The test module only in a crate compiled for AVX-512F/VL as a whole (the AVX-512
+/// build's `lane_tests`; see [`avx2_tests`]).
+#[proc_macro_attribute]
+pub fn avx512_tests(_args: TokenStream, item: TokenStream) -> TokenStream {
+    prefixed(
+        "#[cfg(all(target_feature = \"avx2\", target_feature = \"avx512f\", target_feature = \"avx512vl\"))]",
+        item,
+    )
 }
 
 /// The test module only in a crate compiled for AVX2 as a whole (the eight-lane build's

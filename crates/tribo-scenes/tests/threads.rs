@@ -1,8 +1,8 @@
-//! Determinism across thread counts and solver widths: a step split between worker threads
+//! Determinism across thread counts and solver builds: a step split between worker threads
 //! must give bit-identical results to the single-threaded step (WorldDef::workers'
-//! promise), and the wide solver's eight-lane build (AVX2, what `SolverLanes::Auto` takes
-//! on a CPU with AVX2) the same results as its four-lane one (WorldDef::solver_lanes'
-//! promise). The scenes mix resting stacks (many graph colours, new contacts estimated on
+//! promise), and the wide solver's eight-lane builds (AVX2, and AVX2 with AVX-512VL, what
+//! `SolverLanes::Auto` takes on a CPU with those) the same results as its four-lane one
+//! (WorldDef::solver_lanes' promise). The scenes mix resting stacks (many graph colours, new contacts estimated on
 //! the first step), sliding, rolling, bouncing and a kinematic body, so every parallel
 //! stage runs.
 
@@ -80,9 +80,14 @@ fn two_and_three_workers_match_one_bit_for_bit() {
     ];
     for (build, steps) in cases {
         let one = run(build, 1, steps);
-        for (workers, lanes) in [(2, SolverLanes::Auto), (3, SolverLanes::Auto), (2, SolverLanes::Four)] {
-            // (Four lanes on two threads: on a CPU with AVX2 the default runs eight, and
-            // the four-lane build's team loop would go untested.)
+        for (workers, lanes) in [
+            (2, SolverLanes::Auto),
+            (3, SolverLanes::Auto),
+            (2, SolverLanes::Eight),
+            (2, SolverLanes::Four),
+        ] {
+            // (Eight and four lanes on two threads: on a CPU with AVX-512 the default runs
+            // that build, and the others' team loops would go untested.)
             let (many, _) = run_with(build, workers, lanes, steps);
             assert!(
                 one == many,
@@ -117,20 +122,30 @@ fn workers_out_of_range_are_rejected_and_change_nothing() {
     .is_err());
 }
 
-/// Eight lanes and four step every library scene to the same bits: every lane computes the
-/// same expressions whatever the width (no tolerance: the promise is identity, and any
-/// reordering of a sum would show in the last bit within a few steps of a pile). On a CPU
-/// without AVX2 both worlds run four lanes and the test says so (it then cannot fail on the
-/// width). Checked by mutation: with the eight-lane subtraction made an addition it fails
-/// on the first scene.
+/// Every build of the wide solver steps every library scene to the same bits: eight lanes
+/// for AVX-512VL (`Auto` on a CPU with it), eight for AVX2 (`Eight`) and four (`Four`).
+/// Every lane computes the same expressions whatever the width and the instructions (no
+/// tolerance: the promise is identity, and any reordering of a sum would show in the last
+/// bit within a few steps of a pile). On a CPU without AVX-512 `Auto` and `Eight` run the
+/// same build, and without AVX2 all three run four lanes; the test says so (it then cannot
+/// fail on what the CPU lacks). Checked by mutation: with the eight-lane subtraction made
+/// an addition it fails on the first scene.
 #[test]
-fn eight_and_four_lanes_step_every_scene_to_the_same_bits() {
-    let auto = tribo::solver_lanes();
-    // `Auto` takes eight lanes exactly where the CPU has AVX2.
+fn every_solver_build_steps_every_scene_to_the_same_bits() {
+    let (auto, instructions) = (tribo::solver_lanes(), tribo::solver_instructions());
+    // `Auto` takes eight lanes exactly where the CPU has AVX2, compiled for AVX-512VL
+    // exactly where it also has AVX-512F and VL.
     #[cfg(target_arch = "x86_64")]
-    assert_eq!(auto == 8, std::is_x86_feature_detected!("avx2"), "lanes taken: {auto}");
+    {
+        let avx2 = std::is_x86_feature_detected!("avx2");
+        let avx512 = avx2 && std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512vl");
+        assert_eq!(auto == 8, avx2, "lanes taken: {auto}");
+        assert_eq!(instructions == "AVX-512VL", avx512, "build taken: {instructions}");
+    }
     if auto == 4 {
-        eprintln!("this CPU has no AVX2: both worlds run four lanes");
+        eprintln!("this CPU has no AVX2: all the worlds run four lanes");
+    } else if instructions != "AVX-512VL" {
+        eprintln!("this CPU has no AVX-512VL: `Auto` and `Eight` run the same build");
     }
     for entry in SCENES {
         // Long enough for piles to settle (new contacts estimated, friction states
@@ -142,10 +157,11 @@ fn eight_and_four_lanes_step_every_scene_to_the_same_bits() {
             120
         };
         let (wide, lanes_auto) = run_with(entry.build, 1, SolverLanes::Auto, steps);
+        let (eight, lanes_eight) = run_with(entry.build, 1, SolverLanes::Eight, steps);
         let (four, lanes_four) = run_with(entry.build, 1, SolverLanes::Four, steps);
         assert_eq!(
-            (lanes_auto, lanes_four),
-            (auto, 4),
+            (lanes_auto, lanes_eight, lanes_four),
+            (auto, auto, 4),
             "{}: the worlds' lane counts",
             entry.name
         );
@@ -158,20 +174,23 @@ fn eight_and_four_lanes_step_every_scene_to_the_same_bits() {
             "{}: nothing moved in {steps} steps",
             entry.name
         );
-        let differ = wide.iter().zip(&four).filter(|(a, b)| a != b).count();
-        assert!(
-            differ == 0 && wide.len() == four.len(),
-            "{}: {auto} lanes and 4 lanes differ in {differ} of {} values after {steps} steps",
-            entry.name,
-            wide.len()
-        );
+        for (build, state) in [(instructions, &wide), ("Eight (AVX2)", &eight)] {
+            let differ = state.iter().zip(&four).filter(|(a, b)| a != b).count();
+            assert!(
+                differ == 0 && state.len() == four.len(),
+                "{}: {auto} lanes ({build}) and 4 lanes differ in {differ} of {} values after {steps} steps",
+                entry.name,
+                state.len()
+            );
+        }
     }
 }
 
 /// Changing `WorldDef::solver_lanes` mid-run (a new solver; the contacts keep their colours)
 /// changes no result either: the tumbler (its turning drum keeps every box awake and
-/// moving), once its boxes pile up in the drum, stepped with eight lanes, then four (on two
-/// threads), then eight again, ends where one stepped with four throughout ends.
+/// moving), once its boxes pile up in the drum, stepped with `Auto`'s build, then four lanes
+/// (on two threads), then eight for AVX2, then `Auto`'s again, ends where one stepped with
+/// four throughout ends.
 #[test]
 fn switching_lanes_mid_run_changes_no_result() {
     let (steady, _) = run_with(scenes::tumbler, 1, SolverLanes::Four, 150);
@@ -181,7 +200,8 @@ fn switching_lanes_mid_run_changes_no_result() {
     for (steps, workers, lanes, expected) in [
         (90, 1, SolverLanes::Auto, auto),
         (30, 2, SolverLanes::Four, 4),
-        (30, 1, SolverLanes::Auto, auto),
+        (20, 1, SolverLanes::Eight, auto),
+        (10, 1, SolverLanes::Auto, auto),
     ] {
         with(&mut world, workers, lanes);
         assert_eq!(world.solver_lanes(), expected, "the switch to {lanes:?} took");

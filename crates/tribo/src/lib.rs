@@ -67,10 +67,11 @@ pub use world::{
 
 /// Contact constraints the wide solver handles at once in a world made with the default
 /// [`SolverLanes::Auto`] on this CPU: 8 on an x86-64 CPU that has AVX2 (the solver is
-/// compiled a second time for AVX2 into every x86-64 build and chosen at run time, so a
-/// binary for the x86-64 baseline still runs eight lanes there; Box2D's counterpart,
-/// `BOX2D_AVX2`, is a compile-time option), else 4 (SSE2, the x86-64 baseline, or arrays
-/// on other targets).
+/// compiled a second time for AVX2, and a third for AVX2 with AVX-512F/VL, into every
+/// x86-64 build and chosen at run time, so a binary for the x86-64 baseline still runs
+/// eight lanes there; Box2D's counterpart, `BOX2D_AVX2`, is a compile-time option), else 4
+/// (SSE2, the x86-64 baseline, or arrays on other targets). [`solver_instructions`] says
+/// which build.
 ///
 /// Results do not depend on it: every lane computes the same expressions, and where a
 /// group takes one branch for all its lanes (the one-point form of the normal rows, the
@@ -82,15 +83,22 @@ pub fn solver_lanes() -> usize {
     solver::Contacts::new(SolverLanes::Auto).lanes()
 }
 
+/// The instructions the wide solver of a world made with the default [`SolverLanes::Auto`]
+/// is compiled for on this CPU: "AVX-512VL" (eight lanes, with AVX2), "AVX2" (eight
+/// lanes), "SSE2" (four lanes, on x86-64) or "portable" (four lanes, elsewhere).
+pub fn solver_instructions() -> &'static str {
+    solver::Contacts::new(SolverLanes::Auto).instructions()
+}
+
 /// The crate version and the wide solver [`solver_lanes`] picks on this CPU, e.g. `0.1.0
-/// (solver: 8 lanes, AVX2)` or `0.1.0 (solver: 4 lanes, SSE2)` (what `tribo --version`
-/// prints).
+/// (solver: 8 lanes, AVX-512VL)`, `0.1.0 (solver: 8 lanes, AVX2)` or `0.1.0 (solver: 4
+/// lanes, SSE2)` (what `tribo --version` prints).
 pub fn build_info() -> String {
-    let lanes = solver_lanes();
-    let simd = match (cfg!(target_arch = "x86_64"), lanes) {
-        (true, 8) => ", AVX2",
-        (true, _) => ", SSE2",
-        (false, _) => "",
-    };
-    format!("{} (solver: {lanes} lanes{simd})", env!("CARGO_PKG_VERSION"))
+    let solver = solver::Contacts::new(SolverLanes::Auto);
+    format!(
+        "{} (solver: {} lanes, {})",
+        env!("CARGO_PKG_VERSION"),
+        solver.lanes(),
+        solver.instructions()
+    )
 }

@@ -1,11 +1,13 @@
-//! Eight-lane floats for the wide contact solver's eight-lane build (`solver::lanes8`,
-//! compiled for AVX2 and chosen at run time on a CPU that has it): the same operations as
+//! Eight-lane floats for the wide contact solver's eight-lane builds (`solver::lanes8`,
+//! compiled for AVX2, and `solver::lanes8_avx512`, for AVX2 with AVX-512F/VL, chosen at
+//! run time on a CPU that has them): the same operations as
 //! [`super::wide::F4`] and [`super::wide::M4`], each one AVX instruction on a 256-bit
 //! register. Every operation is lane-wise plain IEEE arithmetic (no fused multiply-add, no
 //! approximate reciprocal), so a lane computes bit for bit what the same scalar expression
 //! computes, as with four lanes.
 //!
-//! Used only through `solver::lanes8::wide::{FL, ML, VL}`, in functions compiled for AVX2:
+//! Used only through `solver::lanes8::wide::{FL, ML, VL}`, in functions compiled for AVX2
+//! (or for AVX2 with AVX-512F/VL):
 //! the operations here are `#[inline(always)]` and take the AVX instructions only once
 //! inlined there (out of line, each intrinsic would be a call).
 
@@ -41,8 +43,9 @@ mod avx {
             #[inline(always)]
             pub fn $name$(<const $c: i32>)?($($a: $t),*) -> $r {
                 // SAFETY: the CPU has AVX and AVX2 wherever an eight-lane value exists:
-                // they are made and used only in `solver::lanes8`, whose solver the world
-                // takes only after `is_x86_feature_detected!("avx2")` (`solver::Contacts`),
+                // they are made and used only in `solver::lanes8` and
+                // `solver::lanes8_avx512`, whose solvers the world takes only after
+                // `is_x86_feature_detected!("avx2")` (`solver::Contacts`),
                 // or in a crate compiled for AVX2 as a whole, or in this module's tests,
                 // which return first on a CPU without it. These intrinsics work on
                 // values only: they read and write no memory.

@@ -1198,10 +1198,10 @@ impl ContactSolver {
     }
 }
 
-// In the eight-lane build the passes are compiled for AVX2 (`#[super::lane_fn]`), and
-// calling one from here is `unsafe`: sound, since that build's solver is only ever made on
-// a CPU with AVX2 (`solver::Contacts::new`). In the four-lane build the blocks are plain
-// calls (`unused_unsafe`).
+// In the eight-lane builds the passes are compiled for AVX2 (or AVX2 with AVX-512F/VL,
+// `#[super::lane_fn]`), and calling one from here is `unsafe`: sound, since that build's
+// solver is only ever made on a CPU with those (`solver::Contacts::new`). In the four-lane
+// build the blocks are plain calls (`unused_unsafe`).
 #[allow(unsafe_code, unused_unsafe)]
 impl ConstraintSet for ContactSolver {
     fn has_new_contacts(&self) -> bool {

@@ -8,7 +8,8 @@
 //! A function compiled for AVX2 runs only on a CPU that has it: the world takes this
 //! build's [`contact_set::ContactSolver`] only after `is_x86_feature_detected!("avx2")`
 //! ([`super::Contacts`]), and every call into it from code not compiled for AVX2 goes
-//! through that solver's methods.
+//! through that solver's methods. On a CPU that also has AVX-512F/VL the world takes the
+//! same source's third build instead, [`super::lanes8_avx512`] (its lane types are these).
 
 /// The lane types of this build.
 pub(crate) mod wide {

@@ -28,6 +28,8 @@ pub(crate) mod joint_solver;
 pub(crate) mod lanes4;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod lanes8;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod lanes8_avx512;
 pub(crate) mod softness;
 pub(crate) use crate::math::wide;
 
@@ -992,15 +994,17 @@ pub(crate) trait WideContacts: ConstraintSet {
     fn layout_size(&self) -> (usize, usize);
 }
 
-/// The contact constraints of the world, in the build of the wide solver it runs: eight
-/// lanes ([`lanes8`], AVX2) on an x86-64 CPU that has AVX2 unless the world asks for four
-/// ([`crate::SolverLanes`]), else four ([`lanes4`], SSE2 on x86-64). The two give the same
-/// results to the bit (every lane computes the same expressions; see
-/// [`crate::solver_lanes`]).
+/// The contact constraints of the world, in the build of the wide solver it runs: on an
+/// x86-64 CPU with AVX2 eight lanes ([`lanes8_avx512`] if it also has AVX-512F and
+/// AVX-512VL, else [`lanes8`]) unless the world asks for another ([`crate::SolverLanes`]),
+/// else four ([`lanes4`], SSE2 on x86-64). All give the same results to the bit (every lane
+/// computes the same expressions; see [`crate::solver_lanes`]).
 pub(crate) enum Contacts {
     Four(lanes4::contact_set::ContactSolver),
     #[cfg(target_arch = "x86_64")]
     Eight(lanes8::contact_set::ContactSolver),
+    #[cfg(target_arch = "x86_64")]
+    EightAvx512(lanes8_avx512::contact_set::ContactSolver),
 }
 
 impl Default for Contacts {
@@ -1009,13 +1013,15 @@ impl Default for Contacts {
     }
 }
 
-/// `$body` with `$s` the world's contact solver of either build (`$c`: a [`Contacts`]).
+/// `$body` with `$s` the world's contact solver of any build (`$c`: a [`Contacts`]).
 macro_rules! with_contacts {
     ($c:expr, $s:ident => $body:expr) => {
         match $c {
             $crate::solver::Contacts::Four($s) => $body,
             #[cfg(target_arch = "x86_64")]
             $crate::solver::Contacts::Eight($s) => $body,
+            #[cfg(target_arch = "x86_64")]
+            $crate::solver::Contacts::EightAvx512($s) => $body,
         }
     };
 }
@@ -1025,9 +1031,17 @@ impl Contacts {
     /// The solver a world with `lanes` takes on this CPU.
     pub fn new(lanes: crate::SolverLanes) -> Contacts {
         #[cfg(target_arch = "x86_64")]
-        if lanes == crate::SolverLanes::Auto && std::is_x86_feature_detected!("avx2") {
-            // The only place an eight-lane solver is made: its passes are compiled for AVX2
-            // (see `lanes8`).
+        if lanes != crate::SolverLanes::Four && std::is_x86_feature_detected!("avx2") {
+            if lanes == crate::SolverLanes::Auto
+                && std::is_x86_feature_detected!("avx512f")
+                && std::is_x86_feature_detected!("avx512vl")
+            {
+                // The only place an AVX-512 solver is made: its passes are compiled for
+                // AVX-512F/VL (see `lanes8_avx512`).
+                return Contacts::EightAvx512(Default::default());
+            }
+            // The only place an eight-lane AVX2 solver is made: its passes are compiled for
+            // AVX2 (see `lanes8`).
             return Contacts::Eight(Default::default());
         }
         let _ = lanes;
@@ -1039,7 +1053,20 @@ impl Contacts {
         match self {
             Contacts::Four(_) => lanes4::wide::LANES,
             #[cfg(target_arch = "x86_64")]
-            Contacts::Eight(_) => lanes8::wide::LANES,
+            Contacts::Eight(_) | Contacts::EightAvx512(_) => lanes8::wide::LANES,
+        }
+    }
+
+    /// The instructions the build is compiled for: "AVX-512VL" (with AVX2), "AVX2", "SSE2"
+    /// (the x86-64 baseline), or "portable" (arrays, on other targets).
+    pub fn instructions(&self) -> &'static str {
+        match self {
+            Contacts::Four(_) if cfg!(target_arch = "x86_64") => "SSE2",
+            Contacts::Four(_) => "portable",
+            #[cfg(target_arch = "x86_64")]
+            Contacts::Eight(_) => "AVX2",
+            #[cfg(target_arch = "x86_64")]
+            Contacts::EightAvx512(_) => "AVX-512VL",
         }
     }
 

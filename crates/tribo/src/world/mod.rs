@@ -69,21 +69,28 @@ pub struct WorldDef {
     /// affect each other (constraints of one graph colour share no moving body) and
     /// gathered back in a fixed order.
     pub workers: u32,
-    /// How many contact constraints the wide solver handles at once. Default
-    /// [`SolverLanes::Auto`]: eight (AVX2) on an x86-64 CPU that has AVX2, else four. Results
-    /// are bit-identical either way ([`crate::solver_lanes`]); only the speed differs.
+    /// How many contact constraints the wide solver handles at once, and which build of it
+    /// runs. Default [`SolverLanes::Auto`]: eight (AVX2, with AVX-512VL where the CPU has
+    /// it) on an x86-64 CPU that has AVX2, else four. Results are bit-identical every way
+    /// ([`crate::solver_lanes`]); only the speed differs.
     pub solver_lanes: SolverLanes,
 }
 
 /// Which build of the wide contact solver a world runs ([`WorldDef::solver_lanes`]). The
-/// solver is compiled both ways into every x86-64 binary; the world picks one when it is
-/// made (or given new settings).
+/// solver is compiled three ways into every x86-64 binary (four lanes for SSE2, eight for
+/// AVX2, eight for AVX2 with AVX-512F/VL); the world picks one when it is made (or given
+/// new settings), and [`World::solver_instructions`] says which.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum SolverLanes {
-    /// Eight lanes (AVX2) if the CPU has AVX2, else four: the fastest this CPU runs. The
-    /// default.
+    /// The fastest this CPU runs: eight lanes compiled for AVX-512VL if the CPU has
+    /// AVX-512F and AVX-512VL (the same 256-bit vectors as AVX2, with 32 registers instead
+    /// of 16: 5–7 % off large_pyramid's and the tumbler's step), else eight compiled for
+    /// AVX2 if it has AVX2, else four. The default.
     #[default]
     Auto,
+    /// Eight lanes compiled for AVX2 only, even on a CPU with AVX-512 (four without AVX2),
+    /// e.g. to compare or to test that build.
+    Eight,
     /// Four lanes (SSE2 on x86-64, the baseline every x86-64 CPU has), e.g. to compare.
     Four,
 }
@@ -389,6 +396,13 @@ impl World {
     /// [`WorldDef::solver_lanes`]).
     pub fn solver_lanes(&self) -> usize {
         self.contact_solver.lanes()
+    }
+
+    /// The instructions the wide solver of this world is compiled for: "AVX-512VL" (eight
+    /// lanes, with AVX2), "AVX2" (eight lanes), "SSE2" (four lanes, on x86-64) or
+    /// "portable" (four lanes, elsewhere). See [`WorldDef::solver_lanes`].
+    pub fn solver_instructions(&self) -> &'static str {
+        self.contact_solver.instructions()
     }
 
     /// Per-stage wall-clock times of the last step.
