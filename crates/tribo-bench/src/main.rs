@@ -283,8 +283,13 @@ fn print_header(args: &Args) {
             tribo::build_info()
         ),
         tribo::SolverLanes::Eight => println!(
-            "Tribo {} on this CPU; here worlds with SolverLanes::Eight: 8 lanes, AVX2 only (TRIBO_BENCH_LANES=8)",
-            tribo::build_info()
+            "Tribo {} on this CPU; here worlds with SolverLanes::Eight: {} (TRIBO_BENCH_LANES=8)",
+            tribo::build_info(),
+            if tribo::solver_lanes() == 8 {
+                "8 lanes, AVX2 only"
+            } else {
+                "4 lanes (no AVX2 here)"
+            }
         ),
         _ => println!("Tribo {}", tribo::build_info()),
     }

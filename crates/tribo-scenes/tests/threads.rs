@@ -41,21 +41,25 @@ fn with(world: &mut World, workers: u32, lanes: SolverLanes) {
 }
 
 /// [`state_bits`] after `steps` steps with `workers` threads and `lanes` (the scene's step
-/// hook not run: `.ci/run` compares hooked scenes through the CLI), and the world's lane
-/// count.
+/// hook not run: `.ci/run` compares hooked scenes through the CLI), the world's lane count
+/// and the instructions its solver build is compiled for.
 fn run_with(
     build: fn() -> tribo_scenes::format::SceneFile,
     workers: u32,
     lanes: SolverLanes,
     steps: u32,
-) -> (Vec<u32>, usize) {
+) -> (Vec<u32>, usize, &'static str) {
     let built = build().build().expect("scene builds");
     let mut world: World = built.world;
     with(&mut world, workers, lanes);
     for _ in 0..steps {
         world.step(built.dt).expect("step");
     }
-    (state_bits(&world, &built.bodies), world.solver_lanes())
+    (
+        state_bits(&world, &built.bodies),
+        world.solver_lanes(),
+        world.solver_instructions(),
+    )
 }
 
 /// [`state_bits`] after `steps` steps with `workers` threads.
@@ -88,7 +92,7 @@ fn two_and_three_workers_match_one_bit_for_bit() {
         ] {
             // (Eight and four lanes on two threads: on a CPU with AVX-512 the default runs
             // that build, and the others' team loops would go untested.)
-            let (many, _) = run_with(build, workers, lanes, steps);
+            let (many, _, _) = run_with(build, workers, lanes, steps);
             assert!(
                 one == many,
                 "{workers} workers ({lanes:?} lanes) differ from 1 worker in {} of {} values",
@@ -134,11 +138,17 @@ fn workers_out_of_range_are_rejected_and_change_nothing() {
 fn every_solver_build_steps_every_scene_to_the_same_bits() {
     let (auto, instructions) = (tribo::solver_lanes(), tribo::solver_instructions());
     // `Auto` takes eight lanes exactly where the CPU has AVX2, compiled for AVX-512VL
-    // exactly where it also has AVX-512F and VL.
+    // exactly where it also has AVX-512F and VL, what the compiler takes those to imply
+    // (FMA, F16C), and AVX-512 VBMI2 (Ice Lake's generation or later).
     #[cfg(target_arch = "x86_64")]
     {
         let avx2 = std::is_x86_feature_detected!("avx2");
-        let avx512 = avx2 && std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512vl");
+        let avx512 = avx2
+            && std::is_x86_feature_detected!("avx512f")
+            && std::is_x86_feature_detected!("avx512vl")
+            && std::is_x86_feature_detected!("fma")
+            && std::is_x86_feature_detected!("f16c")
+            && std::is_x86_feature_detected!("avx512vbmi2");
         assert_eq!(auto == 8, avx2, "lanes taken: {auto}");
         assert_eq!(instructions == "AVX-512VL", avx512, "build taken: {instructions}");
     }
@@ -156,19 +166,21 @@ fn every_solver_build_steps_every_scene_to_the_same_bits() {
         } else {
             120
         };
-        let (wide, lanes_auto) = run_with(entry.build, 1, SolverLanes::Auto, steps);
-        let (eight, lanes_eight) = run_with(entry.build, 1, SolverLanes::Eight, steps);
-        let (four, lanes_four) = run_with(entry.build, 1, SolverLanes::Four, steps);
+        let (wide, lanes_auto, built_auto) = run_with(entry.build, 1, SolverLanes::Auto, steps);
+        let (eight, lanes_eight, built_eight) = run_with(entry.build, 1, SolverLanes::Eight, steps);
+        let (four, lanes_four, built_four) = run_with(entry.build, 1, SolverLanes::Four, steps);
+        // `Eight` takes the AVX2 build wherever there are eight lanes, whatever `Auto` takes.
+        let eight_build = if auto == 8 { "AVX2" } else { built_four };
         assert_eq!(
-            (lanes_auto, lanes_eight, lanes_four),
-            (auto, auto, 4),
-            "{}: the worlds' lane counts",
+            (lanes_auto, lanes_eight, lanes_four, built_auto, built_eight),
+            (auto, auto, 4, instructions, eight_build),
+            "{}: the worlds' lane counts and builds",
             entry.name
         );
         // The scene really moved (else the comparison would prove nothing), but for one
         // whose moving bodies all come from its step hook (rain: only its static shelves
         // are the scene's own; `.ci/run` compares it through the CLI, hook and all).
-        let (start, _) = run_with(entry.build, 1, SolverLanes::Four, 0);
+        let (start, _, _) = run_with(entry.build, 1, SolverLanes::Four, 0);
         assert!(
             start != four || entry.name == "rain",
             "{}: nothing moved in {steps} steps",
@@ -193,18 +205,28 @@ fn every_solver_build_steps_every_scene_to_the_same_bits() {
 /// four throughout ends.
 #[test]
 fn switching_lanes_mid_run_changes_no_result() {
-    let (steady, _) = run_with(scenes::tumbler, 1, SolverLanes::Four, 150);
+    let (steady, _, _) = run_with(scenes::tumbler, 1, SolverLanes::Four, 150);
     let built = scenes::tumbler().build().expect("scene builds");
     let mut world = built.world;
-    let auto = tribo::solver_lanes();
+    let (auto, instructions) = (tribo::solver_lanes(), tribo::solver_instructions());
+    let four = if cfg!(target_arch = "x86_64") {
+        "SSE2"
+    } else {
+        "portable"
+    };
+    let eight = if auto == 8 { "AVX2" } else { four };
     for (steps, workers, lanes, expected) in [
-        (90, 1, SolverLanes::Auto, auto),
-        (30, 2, SolverLanes::Four, 4),
-        (20, 1, SolverLanes::Eight, auto),
-        (10, 1, SolverLanes::Auto, auto),
+        (90, 1, SolverLanes::Auto, (auto, instructions)),
+        (30, 2, SolverLanes::Four, (4, four)),
+        (20, 1, SolverLanes::Eight, (auto, eight)),
+        (10, 1, SolverLanes::Auto, (auto, instructions)),
     ] {
         with(&mut world, workers, lanes);
-        assert_eq!(world.solver_lanes(), expected, "the switch to {lanes:?} took");
+        assert_eq!(
+            (world.solver_lanes(), world.solver_instructions()),
+            expected,
+            "the switch to {lanes:?} took"
+        );
         let before = state_bits(&world, &built.bodies);
         for _ in 0..steps {
             world.step(built.dt).expect("step");

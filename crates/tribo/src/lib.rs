@@ -77,8 +77,8 @@ pub use world::{
 /// group takes one branch for all its lanes (the one-point form of the normal rows, the
 /// rolling row) the other branch adds only exact zeros, which can at most turn a velocity
 /// of −0.0 into +0.0 (and the velocity integration makes every −0.0 +0.0 anyway, unless an
-/// acceleration is −0.0). Worlds with four and eight lanes step a scene to the same bits
-/// (a test steps every library scene both ways; `.ci/run` compares CLI trajectories).
+/// acceleration is −0.0). Worlds with every build step a scene to the same bits (a test
+/// steps every library scene every way; `.ci/run` compares CLI trajectories).
 pub fn solver_lanes() -> usize {
     solver::Contacts::new(SolverLanes::Auto).lanes()
 }
@@ -91,8 +91,9 @@ pub fn solver_instructions() -> &'static str {
 }
 
 /// The crate version and the wide solver [`solver_lanes`] picks on this CPU, e.g. `0.1.0
-/// (solver: 8 lanes, AVX-512VL)`, `0.1.0 (solver: 8 lanes, AVX2)` or `0.1.0 (solver: 4
-/// lanes, SSE2)` (what `tribo --version` prints).
+/// (solver: 8 lanes, AVX-512VL)`, `0.1.0 (solver: 8 lanes, AVX2)`, `0.1.0 (solver: 4
+/// lanes, SSE2)` or, off x86-64, `0.1.0 (solver: 4 lanes, portable)` (what `tribo
+/// --version` prints).
 pub fn build_info() -> String {
     let solver = solver::Contacts::new(SolverLanes::Auto);
     format!(

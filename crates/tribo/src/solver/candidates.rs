@@ -1,5 +1,5 @@
-//! The solver's view of the step's touching contacts, the same for either build of the
-//! wide solver (`lanes4`, `lanes8`): each contact's [`Candidate`] (what building its
+//! The solver's view of the step's touching contacts, the same for every build of the
+//! wide solver (`lanes4`, `lanes8`, `lanes8_avx512`): each contact's [`Candidate`] (what building its
 //! constraint reads) and [`ColourKey`] (what the colouring reads), and the flags of a
 //! constraint's colour byte.
 

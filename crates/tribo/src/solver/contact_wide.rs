@@ -1628,9 +1628,10 @@ pub(crate) fn unpack_full(
 mod tests {
     use super::*;
 
-    /// `$call` of a function under test. In the eight-lane build the functions are compiled
-    /// for AVX2 and their call is `unsafe`: these tests exist there only in a crate compiled
-    /// for AVX2 as a whole (`lane_tests`), so the CPU has it. A plain call with four lanes.
+    /// `$call` of a function under test. In the eight-lane builds the functions are
+    /// compiled for AVX2 (or for AVX2 with AVX-512F/VL) and their call is `unsafe`: these
+    /// tests exist there only in a crate compiled for those as a whole (`lane_tests`), so
+    /// the CPU has them. A plain call with four lanes.
     macro_rules! lane_call {
         ($call:expr) => {{
             #[allow(unsafe_code, unused_unsafe)]

@@ -25,7 +25,7 @@ pub(crate) mod wide {
 pub(crate) use tribo_lanes::avx2_tests as lane_tests;
 pub(crate) use tribo_lanes::{avx2 as lane_fn, avx2_inline as lane_inline};
 
-// The same files as `lanes4`'s, on purpose (one source, two builds).
+// The same files as `lanes4`'s and `lanes8_avx512`'s, on purpose (one source, three builds).
 #[path = "contact_wide.rs"]
 #[allow(clippy::duplicate_mod)]
 pub(crate) mod contact_wide;

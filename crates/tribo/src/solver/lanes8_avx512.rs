@@ -11,9 +11,13 @@
 //!
 //! A function compiled for AVX-512 runs only on a CPU that has it: the world takes this
 //! build's [`contact_set::ContactSolver`] only after `is_x86_feature_detected!` of AVX2,
-//! AVX-512F and AVX-512VL ([`super::Contacts`]), and every call into it from code not
-//! compiled for these goes through that solver's methods. 256-bit instructions do not
-//! lower the clock of the CPUs that do so for AVX-512's 512-bit ones.
+//! AVX-512F and AVX-512VL (and what the compiler takes AVX-512F to imply, FMA and F16C;
+//! `super::avx512_build_pays`), and every call into it from code not compiled for these
+//! goes through that solver's methods. The lanes stay 256 bits wide, but the compiler
+//! writes some copies of records and some loops with 512-bit registers (moves mostly, a
+//! few multiplications and additions), and the cores before Ice Lake lower their clock
+//! for those: `Auto` takes this build only on a CPU with AVX-512 VBMI2 (Ice Lake, Zen 4
+//! and later), the AVX2 one elsewhere.
 
 /// The lane types of this build: the eight-lane build's.
 pub(crate) use super::lanes8::wide;

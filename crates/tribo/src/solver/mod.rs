@@ -63,8 +63,8 @@ pub(crate) struct BodyState {
 /// [`SharedState::from_mut_slice`], [`prefetch`], the SSE intrinsics of [`wide`], the lanes
 /// of a [`wide`] register read as an array (its `Deref`), the row access of [`rows_at`]
 /// and [`write_velocity_row`], `math::wide8`'s AVX intrinsics and lanes, and the calls into
-/// the eight-lane solver compiled for AVX2 in `contact_set`'s `ConstraintSet` and
-/// [`WideContacts`] impls).
+/// the eight-lane solvers compiled for AVX2 (and for AVX2 with AVX-512F/VL) in
+/// `contact_set`'s `ConstraintSet` and [`WideContacts`] impls).
 ///
 /// Why it is race-free — the contract every user of [`StateCell`] for `SharedState` keeps:
 /// - a constraint pass runs colour by colour, and the constraints of one colour share no
@@ -926,7 +926,7 @@ pub(crate) trait ConstraintSet {
     }
 }
 
-/// The constraints of a step: joints, then contacts (of either build of the wide solver),
+/// The constraints of a step: joints, then contacts (of any build of the wide solver),
 /// in every pass.
 pub(crate) struct StepConstraints<'a, C> {
     pub joints: &'a mut joint_solver::JointSolver,
@@ -995,8 +995,8 @@ pub(crate) trait WideContacts: ConstraintSet {
 }
 
 /// The contact constraints of the world, in the build of the wide solver it runs: on an
-/// x86-64 CPU with AVX2 eight lanes ([`lanes8_avx512`] if it also has AVX-512F and
-/// AVX-512VL, else [`lanes8`]) unless the world asks for another ([`crate::SolverLanes`]),
+/// x86-64 CPU with AVX2 eight lanes ([`lanes8_avx512`] if it also has AVX-512F/VL and is
+/// of Ice Lake's generation or later, see `avx512_build_pays`, else [`lanes8`]) unless the world asks for another ([`crate::SolverLanes`]),
 /// else four ([`lanes4`], SSE2 on x86-64). All give the same results to the bit (every lane
 /// computes the same expressions; see [`crate::solver_lanes`]).
 pub(crate) enum Contacts {
@@ -1011,6 +1011,21 @@ impl Default for Contacts {
     fn default() -> Contacts {
         Contacts::Four(Default::default())
     }
+}
+
+/// Whether `SolverLanes::Auto` takes the AVX-512 build ([`lanes8_avx512`]) on this CPU: it
+/// has AVX-512F and AVX-512VL (what the build is compiled for), FMA and F16C (which the
+/// compiler takes AVX-512F to imply), and AVX-512 VBMI2, the mark of the cores from Ice
+/// Lake and Zen 4 on. The compiler still writes some copies and loops of that build with
+/// 512-bit registers, and the cores before Ice Lake (Skylake-SP, Cascade Lake) lower their
+/// clock for 512-bit instructions: there the AVX2 build is taken.
+#[cfg(target_arch = "x86_64")]
+fn avx512_build_pays() -> bool {
+    std::is_x86_feature_detected!("avx512f")
+        && std::is_x86_feature_detected!("avx512vl")
+        && std::is_x86_feature_detected!("fma")
+        && std::is_x86_feature_detected!("f16c")
+        && std::is_x86_feature_detected!("avx512vbmi2")
 }
 
 /// `$body` with `$s` the world's contact solver of any build (`$c`: a [`Contacts`]).
@@ -1032,10 +1047,7 @@ impl Contacts {
     pub fn new(lanes: crate::SolverLanes) -> Contacts {
         #[cfg(target_arch = "x86_64")]
         if lanes != crate::SolverLanes::Four && std::is_x86_feature_detected!("avx2") {
-            if lanes == crate::SolverLanes::Auto
-                && std::is_x86_feature_detected!("avx512f")
-                && std::is_x86_feature_detected!("avx512vl")
-            {
+            if lanes == crate::SolverLanes::Auto && avx512_build_pays() {
                 // The only place an AVX-512 solver is made: its passes are compiled for
                 // AVX-512F/VL (see `lanes8_avx512`).
                 return Contacts::EightAvx512(Default::default());

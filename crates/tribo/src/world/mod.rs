@@ -81,11 +81,12 @@ pub struct WorldDef {
 /// AVX2, eight for AVX2 with AVX-512F/VL); the world picks one when it is made (or given
 /// new settings), and [`World::solver_instructions`] says which.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum SolverLanes {
     /// The fastest this CPU runs: eight lanes compiled for AVX-512VL if the CPU has
-    /// AVX-512F and AVX-512VL (the same 256-bit vectors as AVX2, with 32 registers instead
-    /// of 16: 5–7 % off large_pyramid's and the tumbler's step), else eight compiled for
-    /// AVX2 if it has AVX2, else four. The default.
+    /// AVX-512F and AVX-512VL and is of Ice Lake's generation or later (it has AVX-512
+    /// VBMI2; the same 256-bit vectors as AVX2, with 32 registers instead of 16), else
+    /// eight compiled for AVX2 if it has AVX2, else four. The default.
     #[default]
     Auto,
     /// Eight lanes compiled for AVX2 only, even on a CPU with AVX-512 (four without AVX2),
