@@ -513,7 +513,7 @@ impl FrameRecorder {
     /// Keeps the frame of `step` if the picture needs it (every sampled step and the
     /// last one; PNG and SVG draw only the last, but the camera fits the whole run).
     pub fn record(&mut self, sim: &Simulation, step: u32, last: bool) {
-        if self.kind.is_some() && (step % self.every == 0 || last) {
+        if self.kind.is_some() && (step.is_multiple_of(self.every) || last) {
             self.frames.push(sim.frame());
         }
     }

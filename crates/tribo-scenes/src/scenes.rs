@@ -1468,7 +1468,7 @@ pub fn ragdolls() -> SceneFile {
 /// steps (from step 0), the next of the 40 columns while they are not all there, then the
 /// oldest in turn.
 pub fn ragdoll_rain_action(n: u32) -> Option<(usize, bool)> {
-    if n % RAGDOLL_RAIN_INTERVAL != 0 {
+    if !n.is_multiple_of(RAGDOLL_RAIN_INTERVAL) {
         return None;
     }
     let k = (n / RAGDOLL_RAIN_INTERVAL) as usize;

@@ -331,7 +331,7 @@ const _: () = assert!(ORDER_WINDOW <= 32); // colours are bits of a u32
 /// holds whole windows of the solve order): consecutive joints in slot order, coloured so
 /// that the blocks of one colour write no body in common ([`JointSolver::colour_blocks`]).
 const JOINT_BLOCK: usize = 256;
-const _: () = assert!(JOINT_BLOCK % ORDER_WINDOW == 0);
+const _: () = assert!(JOINT_BLOCK.is_multiple_of(ORDER_WINDOW));
 
 /// Fewest joint blocks per thread and colour, on average, for which the step shares its
 /// substeps between threads ([`JointSolver::worth_sharing`]).

@@ -624,7 +624,7 @@ pub(crate) mod awake {
                 while epoch.load(Ordering::Acquire) == at {
                     core::hint::spin_loop();
                     spins = spins.wrapping_add(1);
-                    if spins % 256 == 0 {
+                    if spins.is_multiple_of(256) {
                         if start.elapsed().as_micros() > LIMIT_US {
                             break;
                         }

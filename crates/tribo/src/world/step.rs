@@ -1041,7 +1041,7 @@ impl World {
     /// 0.79 ms on two threads against 0.60 on one; large_pyramid's, whose boxes stay put,
     /// 0.11 against 0.20). Same results.
     fn finalize(&mut self, dt: f32, parallel: bool) {
-        if !parallel || (self.finalize_alone && self.step_count % FINALIZE_RETRY != 0) {
+        if !parallel || (self.finalize_alone && !self.step_count.is_multiple_of(FINALIZE_RETRY)) {
             if parallel {
                 self.alone_finalizes += 1;
             }
@@ -1208,7 +1208,7 @@ impl World {
     fn make_entries(&self) -> bool {
         self.bodies.writes() == self.entries_writes
             && self.written_bodies.is_empty()
-            && (!self.entries_unused || self.step_count % ENTRIES_RETRY == 0)
+            && (!self.entries_unused || self.step_count.is_multiple_of(ENTRIES_RETRY))
     }
 
     /// Whether body `bi` is a bullet, or `None` when its state went non-finite in this
@@ -1273,7 +1273,7 @@ impl World {
         // the tumbler's, pays nothing here).
         let tts = self.def.time_to_sleep;
         // And only every `SLEEP_CHECK_STEPS` steps.
-        if !self.any_rested || self.step_count % SLEEP_CHECK_STEPS != 0 {
+        if !self.any_rested || !self.step_count.is_multiple_of(SLEEP_CHECK_STEPS) {
             return;
         }
         // Islands over the solver slots of the awake bodies (solver order is slot order, so
