@@ -954,19 +954,36 @@ impl ContactSolver {
         sums: &mut [ContactSums],
     ) {
         let groups = self.head.len();
-        let tasks = if ctx.parallel {
-            rayon::current_num_threads().min(groups / STORE_MIN_GROUPS).max(1)
-        } else {
-            1
-        };
-        // Where each run starts: its first group and its first lane's contact (ascending
-        // from run to run, or two runs would share one range).
-        let mut starts = vec![(0usize, 0usize)];
-        for k in 1..tasks {
-            let g = k * groups / tasks;
-            let Some(first) = self.first_contact(g) else { continue };
-            if starts.last().is_some_and(|&(_, at)| first > at) && first < contacts.len() {
-                starts.push((g, first));
+        let threads = if ctx.parallel { rayon::current_num_threads() } else { 1 };
+        let tasks = threads.min(groups / STORE_MIN_GROUPS).max(1);
+        // The runs, each a list of group ranges for one thread and the contacts from its
+        // first (the first run's from 0) to the next run's first. With the team's cuts of
+        // this layout, a run is what one thread solved of a colour (`team_shares`: the
+        // colour's parts, whose contacts interleave), so each thread reads the group
+        // records its cache holds and writes the contacts its next narrow phase visits
+        // (`contact_owners`); cut instead into `tasks` runs of as many groups, each held
+        // whole colours, half of them solved on the other core (large_pyramid's store
+        // scaled ×1.6 on two threads, its collide ×1.8). The contacts follow the solver's
+        // order (`World::reorder_contacts`), so few lanes' contacts lie outside their run:
+        // those are written after, on one thread.
+        let mut chunks: Vec<(core::ops::Range<usize>, usize, usize)> =
+            match self.team_shares(threads).filter(|_| tasks > 1) {
+                Some(shares) => shares.into_iter().map(|(r, k)| (r, 0, k)).collect(),
+                None => (0..tasks)
+                    .map(|k| (k * groups / tasks..(k + 1) * groups / tasks, 0, k))
+                    .collect(),
+            };
+        for (r, first, _) in &mut chunks {
+            *first = self.first_contact(r.start).unwrap_or(0);
+        }
+        chunks.sort_by_key(|c| c.1);
+        type Run = (Vec<core::ops::Range<usize>>, usize, usize);
+        let mut runs: Vec<Run> = Vec::new();
+        for (r, first, k) in chunks {
+            match runs.last_mut() {
+                // The same thread, or not past the last run's first contact: one run.
+                Some(last) if last.2 == k || first <= last.1 || first >= contacts.len() => last.0.push(r),
+                _ => runs.push((vec![r], if runs.is_empty() { 0 } else { first }, k)),
             }
         }
         // Who visits which contacts in the next narrow phase.
@@ -978,33 +995,34 @@ impl ContactSolver {
         }
         self.contact_owners = owners;
         debug_assert_eq!(contacts.len(), sums.len(), "a sum per contact slot");
-        self.store_runs = starts.len();
+        self.store_runs = runs.len();
         let mut strays = Vec::new();
-        if starts.len() == 1 {
+        if runs.len() <= 1 {
             self.store_groups(ctx, states, 0..groups, (contacts, sums), 0, &mut strays);
         } else {
-            let mut runs = Vec::with_capacity(starts.len());
+            let mut kept: Vec<Vec<(u32, u8, StoredContact)>> = vec![Vec::new(); runs.len()];
+            let mut shares: Vec<Vec<_>> = (0..threads).map(|_| Vec::new()).collect();
             let mut rest: &mut [Option<Contact>] = &mut *contacts;
             let mut rest_sums: &mut [ContactSums] = &mut *sums;
-            for (k, &(g, at)) in starts.iter().enumerate() {
-                let (end_group, end_at) = starts.get(k + 1).copied().unwrap_or((groups, usize::MAX));
+            let ends: Vec<usize> = runs.iter().skip(1).map(|r| r.1).chain([usize::MAX]).collect();
+            for (((ranges, at, k), end_at), out) in runs.into_iter().zip(ends).zip(kept.iter_mut()) {
                 // (`contacts` and `sums` have the same length.)
                 let len = end_at.saturating_sub(at).min(rest.len()).min(rest_sums.len());
                 let (mine, tail) = core::mem::take(&mut rest).split_at_mut(len);
                 let (mine_sums, tail_sums) = core::mem::take(&mut rest_sums).split_at_mut(len);
-                runs.push((g..end_group, at, (mine, mine_sums)));
+                let k = if k < shares.len() { k } else { 0 };
+                if let Some(share) = shares.get_mut(k) {
+                    share.push((ranges, at, (mine, mine_sums), out));
+                }
                 rest = tail;
                 rest_sums = tail_sums;
             }
             let this = &*self;
-            let mut kept: Vec<Vec<(u32, u8, StoredContact)>> = vec![Vec::new(); runs.len()];
-            claim_each(
-                true,
-                runs.into_iter().zip(kept.iter_mut()),
-                |((range, base, mine), out)| {
-                    this.store_groups(ctx, states, range, mine, base, out);
-                },
-            );
+            claim_each_share(true, shares, |(ranges, base, (mine, mine_sums), out)| {
+                for range in ranges {
+                    this.store_groups(ctx, states, range, (&mut *mine, &mut *mine_sums), base, out);
+                }
+            });
             strays.extend(kept.into_iter().flatten());
         }
         self.stored_after = strays.len();

@@ -1951,14 +1951,15 @@ mod tests {
 
     /// With two threads, the build hands a kept layout's groups to the threads that solve
     /// them (`ContactSolver::build_shares`), and the threaded store writes each run's
-    /// contacts in place (`ContactSolver::store`):
+    /// contacts in place (`ContactSolver::store`, a run being what one thread solved of a
+    /// colour):
     /// once the contacts are renumbered in the solver's order, nearly every lane's contact
     /// lies in its own run's range, and under 2 % of them are left to be written after, on
     /// one thread. (A wrong cut of the contacts or of their sums between the runs leaves
     /// them all to that serial pass: the results stay right, only slow.)
     #[test]
     fn the_threaded_store_writes_nearly_every_contact_in_place() {
-        // Over 14 000 contacts: two runs of the store, and enough groups per colour for
+        // Over 14 000 contacts: a threaded store, and enough groups per colour for
         // the substeps to run on both threads (`World::solve_with`).
         let mut w = pyramid_on(100, 2);
         for _ in 0..40 {
@@ -1966,11 +1967,9 @@ mod tests {
         }
         assert!(w.reordered_at.is_some(), "the contacts were renumbered");
         let after = with_contacts!(&w.contact_solver, s => s.stored_after);
-        assert_eq!(
-            with_contacts!(&w.contact_solver, s => s.store_runs),
-            2,
-            "one run per thread"
-        );
+        // A run per colour and thread: the groups each thread solved.
+        let runs = with_contacts!(&w.contact_solver, s => s.store_runs);
+        assert!(runs >= 2 * 6, "{runs} runs");
         // The kept layout's groups were built by the threads that solve them.
         assert!(with_contacts!(&w.contact_solver, s => s.shared_builds) >= 30);
         // And the next narrow phase hands each thread the contacts of its groups: a share
