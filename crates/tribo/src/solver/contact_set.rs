@@ -933,19 +933,21 @@ impl ContactSolver {
     /// worker team solved, it also notes where each thread's share of the contacts starts
     /// for the next narrow phase (`contact_owners`).
     ///
-    /// With threads, the groups are cut into one run per thread, and the contact list at
-    /// the contact of each run's first lane: the contacts follow the solver's layout
-    /// (`World::reorder_contacts`), so nearly every lane's contact falls in its own run's
-    /// range, and each task writes its range directly; the few that do not (contacts made
-    /// since the last renumbering) are kept aside and written after, on one thread. Each
-    /// contact is written once, with the same values whatever the split. (Computing every
-    /// lane's values into a buffer first and copying them in contact order, as this did
-    /// before, streamed the buffer twice: large_pyramid's store took 0.64 ms on two threads
-    /// against 0.81 on one.) More runs than threads, so that a thread that loses its core
-    /// would hold up less of the store, cost more than they save: the contacts follow the
-    /// layout only roughly (`World::reorder_contacts` allows one break in three), and cut
-    /// into eight runs large_pyramid had 1 509 contacts a step to write after, serially,
-    /// against 85 with two runs (store +30 % on two threads).
+    /// With threads, the groups are cut into runs (below: after a step the team solved,
+    /// what each thread solved of each colour part, neighbours of one thread merged; else
+    /// one run per thread by group count), and the contact list at the contact of each
+    /// run's first lane: the contacts follow the solver's layout (`World::reorder_contacts`),
+    /// so nearly every lane's contact falls in its own run's range, and each task writes its
+    /// range directly; the few that do not (contacts made since the last renumbering) are
+    /// kept aside and written after, on one thread. Each contact is written once, with the
+    /// same values whatever the split. (Computing every lane's values into a buffer first
+    /// and copying them in contact order, as this did before, streamed the buffer twice:
+    /// large_pyramid's store took 0.64 ms on two threads against 0.81 on one.) Runs cut by
+    /// count into more pieces than threads cost more than they saved (eight runs: 1 509
+    /// contacts a step of large_pyramid to write after, serially, against 85 with two; the
+    /// contacts follow the layout only roughly, `World::reorder_contacts` allows one break in
+    /// three); the team's runs are cut where the layout's own order is, so they keep the
+    /// strays as few (under 2 %, `the_threaded_store_writes_nearly_every_contact_in_place`).
     #[super::lane_fn]
     pub fn store<S: StateRead + Sync>(
         &mut self,
@@ -959,8 +961,9 @@ impl ContactSolver {
         let tasks = threads.min(groups / STORE_MIN_GROUPS).max(1);
         // The runs, each a list of group ranges for one thread and the contacts from its
         // first (the first run's from 0) to the next run's first. With the team's cuts of
-        // this layout, a run is what one thread solved of a colour (`team_shares`: the
-        // colour's parts, whose contacts interleave), so each thread reads the group
+        // this layout, a run is what one thread solved of a colour part (`team_shares`; a
+        // colour's parts' contacts interleave, and one thread's runs that follow one
+        // another in contact order are merged), so each thread reads the group
         // records its cache holds and writes the contacts its next narrow phase visits
         // (`contact_owners`); cut instead into `tasks` runs of as many groups, each held
         // whole colours, half of them solved on the other core (large_pyramid's store
