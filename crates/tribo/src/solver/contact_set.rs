@@ -970,16 +970,17 @@ impl ContactSolver {
         // scaled ×1.6 on two threads, its collide ×1.8). The contacts follow the solver's
         // order (`World::reorder_contacts`), so few lanes' contacts lie outside their run:
         // those are written after, on one thread.
-        let mut chunks: Vec<(core::ops::Range<usize>, usize, usize)> =
-            match self.team_shares(threads).filter(|_| tasks > 1) {
-                Some(shares) => shares.into_iter().map(|(r, k)| (r, 0, k)).collect(),
-                None => (0..tasks)
-                    .map(|k| (k * groups / tasks..(k + 1) * groups / tasks, 0, k))
-                    .collect(),
-            };
-        for (r, first, _) in &mut chunks {
-            *first = self.first_contact(r.start).unwrap_or(0);
-        }
+        let team = self.team_shares(threads);
+        let cuts: BuildChunks = match team.as_ref().filter(|_| tasks > 1) {
+            Some(shares) => shares.clone(),
+            None => (0..tasks)
+                .map(|k| (k * groups / tasks..(k + 1) * groups / tasks, k))
+                .collect(),
+        };
+        let mut chunks: Vec<(core::ops::Range<usize>, usize, usize)> = cuts
+            .into_iter()
+            .map(|(r, k)| (r.clone(), self.first_contact(r.start).unwrap_or(0), k))
+            .collect();
         chunks.sort_by_key(|c| c.1);
         type Run = (Vec<core::ops::Range<usize>>, usize, usize);
         let mut runs: Vec<Run> = Vec::new();
@@ -992,11 +993,7 @@ impl ContactSolver {
         }
         // Who visits which contacts in the next narrow phase.
         let mut owners = core::mem::take(&mut self.contact_owners);
-        if ctx.parallel {
-            self.find_contact_owners(contacts.len(), &mut owners);
-        } else {
-            owners.clear();
-        }
+        self.find_contact_owners(team.as_ref(), contacts.len(), &mut owners);
         self.contact_owners = owners;
         debug_assert_eq!(contacts.len(), sums.len(), "a sum per contact slot");
         self.store_runs = runs.len();
@@ -1446,17 +1443,17 @@ impl ContactSolver {
         }
     }
 
-    /// [`ContactSolver::contact_owners`]: where each thread's share of the team
-    /// ([`ContactSolver::team_shares`]) starts in the contact list (of `contacts` slots),
+    /// [`ContactSolver::contact_owners`]: where each thread's share of the team (`shares`,
+    /// [`ContactSolver::team_shares`]) starts in the contact list (of `contacts` slots),
     /// into `out`; empty without a team's cuts. A share whose first contact does not lie
     /// after the last start (contacts made since the last renumbering) joins the share
     /// before.
-    fn find_contact_owners(&self, contacts: usize, out: &mut Vec<(usize, usize)>) {
+    fn find_contact_owners(&self, shares: Option<&BuildChunks>, contacts: usize, out: &mut Vec<(usize, usize)>) {
         out.clear();
-        let Some(shares) = self.team_shares(rayon::current_num_threads()) else {
+        let Some(shares) = shares else {
             return;
         };
-        for (r, k) in shares {
+        for &(ref r, k) in shares {
             let Some(first) = self.first_contact(r.start) else {
                 continue;
             };

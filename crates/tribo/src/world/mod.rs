@@ -1952,7 +1952,7 @@ mod tests {
     /// With two threads, the build hands a kept layout's groups to the threads that solve
     /// them (`ContactSolver::build_shares`), and the threaded store writes each run's
     /// contacts in place (`ContactSolver::store`, a run being what one thread solved of a
-    /// colour):
+    /// colour part):
     /// once the contacts are renumbered in the solver's order, nearly every lane's contact
     /// lies in its own run's range, and under 2 % of them are left to be written after, on
     /// one thread. (A wrong cut of the contacts or of their sums between the runs leaves
@@ -1967,7 +1967,7 @@ mod tests {
         }
         assert!(w.reordered_at.is_some(), "the contacts were renumbered");
         let after = with_contacts!(&w.contact_solver, s => s.stored_after);
-        // A run per colour and thread: the groups each thread solved.
+        // A run per colour part and thread: the groups each thread solved.
         let runs = with_contacts!(&w.contact_solver, s => s.store_runs);
         assert!(runs >= 2 * 6, "{runs} runs");
         // The kept layout's groups were built by the threads that solve them.
