@@ -1148,9 +1148,13 @@ impl ContactSolver {
 
     /// [`ConstraintSet::warm_start`].
     #[super::lane_fn]
-    fn warm_start_pass<S: StateCell>(&mut self, states: &[S]) {
+    fn warm_start_pass<S: StateCell>(&mut self, states: &[S], carried: bool) {
         for cc in &mut self.overflow {
             warm_start_one(cc, states);
+        }
+        // The groups' warm start came with the velocities (`solver::solve_step`).
+        if carried {
+            return;
         }
         for &(start, end) in &self.ranges {
             let range = start as usize..end as usize;
@@ -1165,7 +1169,14 @@ impl ContactSolver {
 
     /// [`ConstraintSet::solve`].
     #[super::lane_fn]
-    fn solve_pass<S: StateCell>(&mut self, ctx: &StepContext, states: &[S], use_bias: bool, elapsed: f32) {
+    fn solve_pass<S: StateCell>(
+        &mut self,
+        ctx: &StepContext,
+        states: &[S],
+        use_bias: bool,
+        elapsed: f32,
+        carry: Option<&[S]>,
+    ) {
         for cc in &mut self.overflow {
             solve_one(cc, states, ctx, use_bias, elapsed);
         }
@@ -1180,17 +1191,24 @@ impl ContactSolver {
             );
             let derived = &self.derived[range];
             if use_bias {
-                S::for_each_mut3(states, groups, GROUP_CHUNK, |i, h, rare, w, states| {
+                S::for_each_mut3(states, &[], groups, GROUP_CHUNK, |i, h, rare, w, states, _| {
                     if let Some(dv) = derived.get(i) {
-                        contact_wide::solve::<true, S>(h, rare, w, dv, states, ctx, soft, elapsed)
+                        contact_wide::solve::<true, S>(h, rare, w, dv, states, ctx, soft, elapsed, None)
                     }
                 });
             } else {
-                S::for_each_mut3(states, groups, GROUP_CHUNK, |i, h, rare, w, states| {
-                    if let Some(dv) = derived.get(i) {
-                        contact_wide::solve::<false, S>(h, rare, w, dv, states, ctx, soft, elapsed)
-                    }
-                });
+                S::for_each_mut3(
+                    states,
+                    carry.unwrap_or(&[]),
+                    groups,
+                    GROUP_CHUNK,
+                    |i, h, rare, w, states, carry| {
+                        if let Some(dv) = derived.get(i) {
+                            let carry = (!carry.is_empty()).then_some(carry);
+                            contact_wide::solve::<false, S>(h, rare, w, dv, states, ctx, soft, elapsed, carry)
+                        }
+                    },
+                );
             }
         }
         // Extra local sweeps where a light body carries a heavy one, in the relax pass only:
@@ -1263,14 +1281,29 @@ impl ConstraintSet for ContactSolver {
         unsafe { self.estimate_new(ctx, trial) }
     }
 
-    fn warm_start<S: StateCell>(&mut self, _ctx: &StepContext, states: &[S]) {
+    fn warm_start<S: StateCell>(&mut self, _ctx: &StepContext, states: &[S], carried: bool) {
         // SAFETY: see the impl.
-        unsafe { self.warm_start_pass(states) }
+        unsafe { self.warm_start_pass(states, carried) }
     }
 
-    fn solve<S: StateCell>(&mut self, ctx: &StepContext, states: &[S], use_bias: bool, elapsed: f32) {
+    fn solve<S: StateCell>(
+        &mut self,
+        ctx: &StepContext,
+        states: &[S],
+        use_bias: bool,
+        elapsed: f32,
+        carry: Option<&[S]>,
+    ) {
         // SAFETY: see the impl.
-        unsafe { self.solve_pass(ctx, states, use_bias, elapsed) }
+        unsafe { self.solve_pass(ctx, states, use_bias, elapsed, carry) }
+    }
+
+    /// The groups carry their warm start unless some group has restitution (whose warm
+    /// start records each point's approach speed, every substep) or mass-ratio groups
+    /// run (their extra sweeps change impulses after the relax pass carried them). The
+    /// overflow constraints warm start as ever.
+    fn carries_warm_start(&self) -> bool {
+        !self.any_restitution && self.groups.is_empty() && !self.head.is_empty()
     }
 
     fn end_substep(&mut self) {
@@ -1285,10 +1318,11 @@ impl ConstraintSet for ContactSolver {
         ctx: &StepContext,
         sims: &[BodySim],
         states: &[SharedState],
+        carry: &[SharedState],
         times: &mut [f32; 5],
     ) -> bool {
         // SAFETY: see the impl.
-        unsafe { self.team_loop(ctx, sims, states, times) }
+        unsafe { self.team_loop(ctx, sims, states, carry, times) }
     }
 
     fn restitution<S: StateCell>(&mut self, states: &[S]) {
@@ -1309,13 +1343,22 @@ impl ContactSolver {
     /// groups (scalar work the team would have to serialise); those run the per-colour
     /// path.
     #[super::lane_fn]
-    fn team_loop(&mut self, ctx: &StepContext, sims: &[BodySim], states: &[SharedState], times: &mut [f32; 5]) -> bool {
+    fn team_loop(
+        &mut self,
+        ctx: &StepContext,
+        sims: &[BodySim],
+        states: &[SharedState],
+        carry: &[SharedState],
+        times: &mut [f32; 5],
+    ) -> bool {
         let threads = rayon::current_num_threads();
         if threads < 2 || !self.overflow.is_empty() || !self.groups.is_empty() || self.wide.is_empty() {
             return false;
         }
         self.team_steps += 1;
         let soft = self.soft;
+        // (No restitution or mass-ratio groups here; see `solver::solve_step`.)
+        let carries = self.carries_warm_start() && carry.len() >= states.len();
         let bodies_per_thread = team_bodies_per_thread(sims.len(), threads);
         let colours = self.team_blocks(threads, bodies_per_thread);
         let bodies = [team_body_blocks(sims.len(), threads, bodies_per_thread)];
@@ -1327,26 +1370,33 @@ impl ContactSolver {
             let mut at = TeamCursor::default();
             for i in 0..ctx.substeps {
                 let elapsed = i as f32 * ctx.h;
+                let carried = carries && i > 0;
                 team_pass(&bodies, k, &mut at, &progress, |range| {
                     for b in range.clone() {
-                        integrate_velocity_one(ctx.h, &sims[b], &states[b]);
+                        if let (Some(sim), Some(state)) = (sims.get(b), states.get(b)) {
+                            let c = if carried { carry.get(b) } else { None };
+                            integrate_velocity_one(ctx.h, sim, state, c);
+                        }
                     }
                 });
                 t[0] += lap.lap();
-                team_colours(&colours, k, &mut at, &progress, |h, r, rare, _, _| {
-                    contact_wide::warm_start(h, r, rare, states)
-                });
+                if !carried {
+                    team_colours(&colours, k, &mut at, &progress, |h, r, rare, _, _| {
+                        contact_wide::warm_start(h, r, rare, states)
+                    });
+                }
                 t[1] += lap.lap();
                 team_colours(&colours, k, &mut at, &progress, |h, _, rare, w, dv| {
-                    contact_wide::solve::<true, SharedState>(h, rare, w, dv, states, ctx, &soft, elapsed)
+                    contact_wide::solve::<true, SharedState>(h, rare, w, dv, states, ctx, &soft, elapsed, None)
                 });
                 t[2] += lap.lap();
                 team_pass(&bodies, k, &mut at, &progress, |range| {
                     integrate_positions_range(ctx, sims, states, range.clone());
                 });
                 t[3] += lap.lap();
+                let into = (carries && i + 1 < ctx.substeps).then_some(carry);
                 team_colours(&colours, k, &mut at, &progress, |h, _, rare, w, dv| {
-                    contact_wide::solve::<false, SharedState>(h, rare, w, dv, states, ctx, &soft, elapsed + ctx.h)
+                    contact_wide::solve::<false, SharedState>(h, rare, w, dv, states, ctx, &soft, elapsed + ctx.h, into)
                 });
                 t[4] += lap.lap();
             }

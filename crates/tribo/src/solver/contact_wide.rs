@@ -703,7 +703,7 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
     shift: VL,
     ctx: &StepContext,
     (bias_rate, mass_scale, impulse_scale): (FL, FL, FL),
-) -> (FL, FL) {
+) -> ((FL, FL), [(FL, FL); 2]) {
     let n = h.normal;
     let zero = FL::ZERO;
     let one = FL::splat(1.0);
@@ -805,7 +805,7 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
             rare.approach[i] = lower.select(vn, approach);
         }
     }
-    (new0, new1)
+    ((new0, new1), rn)
 }
 
 /// One pass over four constraints: normal rows (block or sequential), the friction row,
@@ -831,6 +831,7 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     ctx: &StepContext,
     soft: &StepSoftness,
     elapsed: f32,
+    carry: Option<&[S]>,
 ) {
     let mut a = gather(states, &h.index_a);
     let mut b = gather(states, &h.index_b);
@@ -854,7 +855,7 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     let (m, disp) = RowFrame::new(h, d, shift, t).point_of(&a, &b, dv.fr_moments);
 
     // Normal rows; groups of single points skip the second point and the block.
-    let (new0, new1) = if h.two_points.any() {
+    let ((new0, new1), rn) = if h.two_points.any() {
         normal_rows::<USE_BIAS, 2>(h, rare, c, dv, &mut a, &mut b, d, shift, ctx, rows)
     } else {
         normal_rows::<USE_BIAS, 1>(h, rare, c, dv, &mut a, &mut b, d, shift, ctx, rows)
@@ -909,6 +910,42 @@ pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
     }
     scatter(states, &h.index_a, &h.write_a, &a);
     scatter(states, &h.index_b, &h.write_b, &b);
+    if let (false, Some(carry)) = (USE_BIAS, carry) {
+        let moments = [rn[0], rn[1], m];
+        carry_warm_start(h, rare, carry, t, moments, [new0, new1, new]);
+    }
+}
+
+/// The next substep's warm start of four constraints, at the end of the relax pass that
+/// set their impulses ([`warm_start`]'s impulses, from the relax's row moments instead
+/// of the arms: the same arms, shifted by the same motion, since no position moves
+/// between the two), added to their bodies' entries in `carry` (see
+/// `solver::solve_step`). `moments`: the two points' normal rows' and the friction row's
+/// (r_a × u, r_b × u); `lambda`: their impulses.
+#[inline(always)]
+fn carry_warm_start<S: StateCell>(
+    h: &WideHead,
+    rare: &WideRare,
+    carry: &[S],
+    t: VL,
+    moments: [(FL, FL); 3],
+    lambda: [FL; 3],
+) {
+    let total = h.normal.scale(lambda[0] + lambda[1]) + t.scale(lambda[2]);
+    let mut moment_a = moments[0].0 * lambda[0] + moments[1].0 * lambda[1] + moments[2].0 * lambda[2];
+    let mut moment_b = moments[0].1 * lambda[0] + moments[1].1 * lambda[1] + moments[2].1 * lambda[2];
+    if h.any_rolling {
+        moment_a += rare.rolling_impulse;
+        moment_b += rare.rolling_impulse;
+    }
+    let mut a = gather(carry, &h.index_a);
+    let mut b = gather(carry, &h.index_b);
+    a.v = a.v - total.scale(h.inv_mass_a);
+    a.w -= h.inv_i_a * moment_a;
+    b.v = b.v + total.scale(h.inv_mass_b);
+    b.w += h.inv_i_b * moment_b;
+    scatter(carry, &h.index_a, &h.write_a, &a);
+    scatter(carry, &h.index_b, &h.write_b, &b);
 }
 
 /// One lane's constraint to build: its contact index, solver input and bodies.
@@ -2103,9 +2140,9 @@ mod tests {
         for pass in 0..6 {
             let (bias, elapsed) = (pass % 2 == 0, (pass / 2) as f32 * ctx.h);
             if bias {
-                solve::<true, _>(&mut h, &mut rare, &mut w, &dv, &wide_states, &ctx, &soft, elapsed);
+                solve::<true, _>(&mut h, &mut rare, &mut w, &dv, &wide_states, &ctx, &soft, elapsed, None);
             } else {
-                solve::<false, _>(&mut h, &mut rare, &mut w, &dv, &wide_states, &ctx, &soft, elapsed);
+                solve::<false, _>(&mut h, &mut rare, &mut w, &dv, &wide_states, &ctx, &soft, elapsed, None);
             }
             for cc in &mut scalar {
                 crate::solver::contact_solver::solve_one(cc, &scalar_states, &ctx, bias, elapsed);
@@ -2208,8 +2245,8 @@ mod tests {
             let (two, rolling) = (h.two_points.any(), h.any_rolling);
             let cells: Vec<core::cell::Cell<BodyState>> = states.iter().map(|&s| core::cell::Cell::new(s)).collect();
             warm_start(&h, &arms, &mut rare, &cells);
-            solve::<true, _>(&mut h, &mut rare, &mut w, &dv, &cells, &ctx, &soft, ctx.h);
-            solve::<false, _>(&mut h, &mut rare, &mut w, &dv, &cells, &ctx, &soft, ctx.h);
+            solve::<true, _>(&mut h, &mut rare, &mut w, &dv, &cells, &ctx, &soft, ctx.h, None);
+            solve::<false, _>(&mut h, &mut rare, &mut w, &dv, &cells, &ctx, &soft, ctx.h, None);
             // Through `Debug`, which tells −0.0 from +0.0.
             let lane = format!(
                 "{:?}",
@@ -2234,6 +2271,73 @@ mod tests {
         assert_eq!(alone.1, beside.1, "its bodies' states");
     }
 
+    /// The relax pass's carry is the next warm start (`carry_warm_start`, see
+    /// `solver::solve_step`): after a relax pass that carries, each body's carry entry
+    /// must equal what [`warm_start`] then adds to its relaxed velocity, for two-point,
+    /// one-point (against the ground) and rolling lanes whose bodies moved and turned
+    /// since the step start (shifted arms). The same impulses on the same arms, summed in
+    /// another order (moments of the rows instead of cross products of the arms), so equal
+    /// to 1e-5 of the largest change: a wrong arm, sign or missing row is off by far more.
+    #[test]
+    fn relax_carries_the_next_warm_start() {
+        let f = fixture();
+        // Lanes of one colour (no dynamic body in two), slow bodies that moved and turned.
+        let cases = [
+            (7u32, input(2, false, 0.0, 0.0), bodies(1, 2)),
+            (9, input(1, false, 0.0, 0.0), bodies(0, 3)),
+            (12, input(2, false, 0.0, 0.05), bodies(4, 5)),
+        ];
+        let moved: Vec<BodyState> = (0..6)
+            .map(|k| BodyState {
+                v: Vec2::new(0.004 * k as f32, -0.003),
+                w: 0.01 * k as f32,
+                touched: 0.0,
+                dp: Vec2::new(1e-3 * k as f32, -2e-3 * k as f32),
+                dq: Rot::from_angle(2e-3 * k as f32),
+            })
+            .collect();
+        let (mut h, arms, mut rare, mut w, _, dv) = built(lanes_of(&cases), f.up, &f.ctx, &moved);
+        let cells = |s: &[BodyState]| -> Vec<core::cell::Cell<BodyState>> {
+            s.iter().map(|&s| core::cell::Cell::new(s)).collect()
+        };
+        let (states, carry) = (cells(&moved), cells(&vec![BodyState::default(); moved.len()]));
+        solve::<false, _>(
+            &mut h,
+            &mut rare,
+            &mut w,
+            &dv,
+            &states,
+            &f.ctx,
+            &f.soft,
+            f.ctx.h,
+            Some(&carry),
+        );
+        let relaxed: Vec<BodyState> = states.iter().map(|c| c.get()).collect();
+        warm_start(&h, &arms, &mut rare, &states);
+        let changes: Vec<(Vec2, f32)> = states
+            .iter()
+            .zip(&relaxed)
+            .map(|(s, r)| (s.get().v - r.v, s.get().w - r.w))
+            .collect();
+        let largest = changes.iter().fold(0.0f32, |m, (v, w)| m.max(v.length()).max(w.abs()));
+        assert!(largest > 0.1, "the warm start changes the velocities ({largest})");
+        assert!(
+            h.any_rolling && h.two_points.any(),
+            "the fixture has rolling and two-point lanes"
+        );
+        for (k, ((v, w), c)) in changes.iter().zip(&carry).enumerate() {
+            let c = c.get();
+            let off = (c.v - *v).length().max((c.w - w).abs());
+            assert!(
+                off <= 1e-5 * largest,
+                "body {k}: carry {:?} {} vs warm start {v:?} {w}",
+                c.v,
+                c.w
+            );
+        }
+        assert_eq!(carry[0].get().v, Vec2::ZERO, "the ground takes no carry");
+    }
+
     /// The store's wide half must write into each contact exactly what the scalar store
     /// writes from the same lane (impulses, totals, the patch's split of the friction
     /// total, preload, slip speed, drift and the stick/slip transition): after a solver
@@ -2244,7 +2348,7 @@ mod tests {
         let f = fixture();
         let (mut h, arms, mut rare, mut w, cold, dv) = built(f.lanes(), f.up, &f.ctx, &f.states);
         let cells: Vec<core::cell::Cell<BodyState>> = f.states.iter().map(|&s| core::cell::Cell::new(s)).collect();
-        solve::<false, _>(&mut h, &mut rare, &mut w, &dv, &cells, &f.ctx, &f.soft, f.ctx.h);
+        solve::<false, _>(&mut h, &mut rare, &mut w, &dv, &cells, &f.ctx, &f.soft, f.ctx.h, None);
         let moved: Vec<BodyState> = cells
             .iter()
             .map(|c| {

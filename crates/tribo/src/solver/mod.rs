@@ -77,6 +77,9 @@ pub(crate) struct BodyState {
 ///   the blocks that found no free colour run one after another on one thread, after the
 ///   others;
 /// - body integration splits the bodies into disjoint ranges, one per task or block;
+/// - the warm-start carry ([`solve_step`]'s `carry`, `SharedState`s too) follows the
+///   states: a relax pass writes the carry entries of the bodies its lanes write (the same
+///   flags, colour by colour), and body integration reads and clears those of its range;
 /// - between colours and stages the threads meet at the end of a rayon scope
 ///   ([`claim_each`]) or wait until every block of the pass is done ([`TeamProgress`]),
 ///   both Release/Acquire, which orders one colour's writes before the next colour's
@@ -208,15 +211,24 @@ pub(crate) trait StateCell: StateRead + Clone + Send {
         min_len: usize,
         f: impl Fn(usize, &mut T, &[Self]) + Sync + Send,
     );
-    /// [`StateCell::for_each_mut`] over three slices of the same length.
+    /// [`StateCell::for_each_mut`] over three slices of the same length, with a second
+    /// set of states (`carry`, handed to `f` as the last argument, under the same rule).
     fn for_each_mut3<T: Send, U: Send, V: Send>(
         states: &[Self],
+        carry: &[Self],
         slices: (&mut [T], &mut [U], &mut [V]),
         min_len: usize,
-        f: impl Fn(usize, &mut T, &mut U, &mut V, &[Self]) + Sync + Send,
+        f: impl Fn(usize, &mut T, &mut U, &mut V, &[Self], &[Self]) + Sync + Send,
     );
-    /// Calls `f(i, states)` for `i` in `0..n` (split between threads for shared states).
-    fn for_each_index(states: &[Self], n: usize, min_len: usize, f: impl Fn(usize, &[Self]) + Sync + Send);
+    /// Calls `f(i, states, carry)` for `i` in `0..n` (split between threads for shared
+    /// states).
+    fn for_each_index(
+        states: &[Self],
+        carry: &[Self],
+        n: usize,
+        min_len: usize,
+        f: impl Fn(usize, &[Self], &[Self]) + Sync + Send,
+    );
     /// The states as shared states, when they are (the worker-team path).
     fn as_shared(states: &[Self]) -> Option<&[SharedState]>;
 }
@@ -250,17 +262,24 @@ impl StateCell for core::cell::Cell<BodyState> {
     }
     fn for_each_mut3<T: Send, U: Send, V: Send>(
         states: &[Self],
+        carry: &[Self],
         (a, b, c): (&mut [T], &mut [U], &mut [V]),
         _min_len: usize,
-        f: impl Fn(usize, &mut T, &mut U, &mut V, &[Self]) + Sync + Send,
+        f: impl Fn(usize, &mut T, &mut U, &mut V, &[Self], &[Self]) + Sync + Send,
     ) {
         for (i, ((x, y), z)) in a.iter_mut().zip(b.iter_mut()).zip(c.iter_mut()).enumerate() {
-            f(i, x, y, z, states);
+            f(i, x, y, z, states, carry);
         }
     }
-    fn for_each_index(states: &[Self], n: usize, _min_len: usize, f: impl Fn(usize, &[Self]) + Sync + Send) {
+    fn for_each_index(
+        states: &[Self],
+        carry: &[Self],
+        n: usize,
+        _min_len: usize,
+        f: impl Fn(usize, &[Self], &[Self]) + Sync + Send,
+    ) {
         for i in 0..n {
-            f(i, states);
+            f(i, states, carry);
         }
     }
     fn as_shared(_: &[Self]) -> Option<&[SharedState]> {
@@ -291,22 +310,29 @@ impl StateCell for SharedState {
     }
     fn for_each_mut3<T: Send, U: Send, V: Send>(
         states: &[Self],
+        carry: &[Self],
         (a, b, c): (&mut [T], &mut [U], &mut [V]),
         min_len: usize,
-        f: impl Fn(usize, &mut T, &mut U, &mut V, &[Self]) + Sync + Send,
+        f: impl Fn(usize, &mut T, &mut U, &mut V, &[Self], &[Self]) + Sync + Send,
     ) {
         let n = min_len.max(1);
         let chunks = a.chunks_mut(n).zip(b.chunks_mut(n)).zip(c.chunks_mut(n)).enumerate();
         claim_each(true, chunks, |(k, ((xs, ys), zs))| {
             for (j, ((x, y), z)) in xs.iter_mut().zip(ys.iter_mut()).zip(zs.iter_mut()).enumerate() {
-                f(k * n + j, x, y, z, states);
+                f(k * n + j, x, y, z, states, carry);
             }
         });
     }
-    fn for_each_index(states: &[Self], n: usize, min_len: usize, f: impl Fn(usize, &[Self]) + Sync + Send) {
+    fn for_each_index(
+        states: &[Self],
+        carry: &[Self],
+        n: usize,
+        min_len: usize,
+        f: impl Fn(usize, &[Self], &[Self]) + Sync + Send,
+    ) {
         let len = min_len.max(1);
         let blocks = (0..n.div_ceil(len)).map(|k| k * len..((k + 1) * len).min(n));
-        claim_each(true, blocks, |range| range.for_each(|i| f(i, states)));
+        claim_each(true, blocks, |range| range.for_each(|i| f(i, states, carry)));
     }
     fn as_shared(states: &[Self]) -> Option<&[SharedState]> {
         Some(states)
@@ -903,10 +929,28 @@ pub(crate) trait ConstraintSet {
     /// rigid iterations against `trial`, the states after one substep of forces. Returns
     /// whether any constraint was estimated. The trial velocities are thrown away.
     fn estimate_new_contacts<C: StateCell>(&mut self, ctx: &StepContext, trial: &[C]) -> bool;
-    /// Re-applies the accumulated impulses at the start of a substep.
-    fn warm_start<C: StateCell>(&mut self, ctx: &StepContext, states: &[C]);
-    /// One sequential-impulse pass; `use_bias` adds the soft position correction.
-    fn solve<C: StateCell>(&mut self, ctx: &StepContext, states: &[C], use_bias: bool, elapsed: f32);
+    /// Re-applies the accumulated impulses at the start of a substep. `carried`: the
+    /// constraints that carry their warm start ([`ConstraintSet::carries_warm_start`])
+    /// skip theirs, which the last relax pass added to the carry and the velocities'
+    /// integration to the states.
+    fn warm_start<C: StateCell>(&mut self, ctx: &StepContext, states: &[C], carried: bool);
+    /// One sequential-impulse pass; `use_bias` adds the soft position correction. With
+    /// `carry` (a relax pass followed by another substep, when the set carries its warm
+    /// start), each constraint that carries its warm start adds the impulse the next
+    /// warm start would apply to its bodies' entries in `carry`.
+    fn solve<C: StateCell>(
+        &mut self,
+        ctx: &StepContext,
+        states: &[C],
+        use_bias: bool,
+        elapsed: f32,
+        carry: Option<&[C]>,
+    );
+    /// Whether this step's constraints (some of them) carry their warm start from each
+    /// relax pass to the next substep's velocities (see [`solve_step`]).
+    fn carries_warm_start(&self) -> bool {
+        false
+    }
     /// Accumulates what a substep applied (after its relax pass).
     fn end_substep(&mut self);
     /// Restitution pass after all substeps.
@@ -920,6 +964,7 @@ pub(crate) trait ConstraintSet {
         _ctx: &StepContext,
         _sims: &[BodySim],
         _states: &[SharedState],
+        _carry: &[SharedState],
         _times: &mut [f32; 5],
     ) -> bool {
         false
@@ -940,13 +985,23 @@ impl<K: ConstraintSet> ConstraintSet for StepConstraints<'_, K> {
     fn estimate_new_contacts<C: StateCell>(&mut self, ctx: &StepContext, trial: &[C]) -> bool {
         self.contacts.estimate_new_contacts(ctx, trial)
     }
-    fn warm_start<C: StateCell>(&mut self, ctx: &StepContext, states: &[C]) {
+    fn warm_start<C: StateCell>(&mut self, ctx: &StepContext, states: &[C], carried: bool) {
         self.joints.warm_start(states, ctx);
-        self.contacts.warm_start(ctx, states);
+        self.contacts.warm_start(ctx, states, carried);
     }
-    fn solve<C: StateCell>(&mut self, ctx: &StepContext, states: &[C], use_bias: bool, elapsed: f32) {
+    fn solve<C: StateCell>(
+        &mut self,
+        ctx: &StepContext,
+        states: &[C],
+        use_bias: bool,
+        elapsed: f32,
+        carry: Option<&[C]>,
+    ) {
         self.joints.solve(states, ctx, use_bias);
-        self.contacts.solve(ctx, states, use_bias, elapsed);
+        self.contacts.solve(ctx, states, use_bias, elapsed, carry);
+    }
+    fn carries_warm_start(&self) -> bool {
+        self.contacts.carries_warm_start()
     }
     fn end_substep(&mut self) {
         self.contacts.end_substep();
@@ -959,11 +1014,12 @@ impl<K: ConstraintSet> ConstraintSet for StepConstraints<'_, K> {
         ctx: &StepContext,
         sims: &[BodySim],
         states: &[SharedState],
+        carry: &[SharedState],
         times: &mut [f32; 5],
     ) -> bool {
         // The team solves contact colours only; joints run before each pass's colours
         // (their block colours shared between threads), which the per-colour path does.
-        self.joints.constraints.is_empty() && self.contacts.substeps_team(ctx, sims, states, times)
+        self.joints.constraints.is_empty() && self.contacts.substeps_team(ctx, sims, states, carry, times)
     }
 }
 
@@ -1095,10 +1151,23 @@ impl Contacts {
 
 /// Runs the stages of one step over the awake bodies and a constraint set, timing each
 /// stage into `profile`.
+///
+/// `carry` (one entry per state, all zero on entry and left so) carries the warm start
+/// from each relax pass to the next substep when the set allows it
+/// ([`ConstraintSet::carries_warm_start`]): a warm start applies each constraint's
+/// accumulated impulses, which the relax pass before it has just set, with the same arms
+/// (the bodies do not move between the two; the velocities' integration between them
+/// only adds forces), so the relax pass adds each constraint's next warm-start impulse to
+/// its bodies' carry entries as it finishes the constraint, and the velocities'
+/// integration adds the carry to each body and clears it. The warm start that follows
+/// then has only the constraints that do not carry theirs left (joints, overflow). The
+/// same sums of the same impulses, rounded in another order: a pass over every group a
+/// substep less (large_pyramid's groups are megabytes).
 pub(crate) fn solve_step<S: StateCell, C: ConstraintSet>(
     ctx: &StepContext,
     sims: &[BodySim],
     states: &[S],
+    carry: &[S],
     constraints: &mut C,
     profile: &mut Profile,
 ) {
@@ -1108,28 +1177,33 @@ pub(crate) fn solve_step<S: StateCell, C: ConstraintSet>(
     // Rapier). Estimate its impulses first on a scratch copy of the states.
     if constraints.has_new_contacts() {
         let trial = states.to_vec();
-        integrate_velocities(ctx, sims, &trial);
+        integrate_velocities(ctx, sims, &trial, None);
         constraints.estimate_new_contacts(ctx, &trial);
     }
     profile.prepare = lap.lap();
     let mut t = [0.0f32; 5];
-    let team = S::as_shared(states).is_some_and(|shared| constraints.substeps_team(ctx, sims, shared, &mut t));
+    let team = S::as_shared(states).is_some_and(|shared| {
+        S::as_shared(carry).is_some_and(|carry| constraints.substeps_team(ctx, sims, shared, carry, &mut t))
+    });
     if team {
         lap.lap();
     }
+    let carries = constraints.carries_warm_start() && carry.len() >= states.len();
     for i in 0..if team { 0 } else { ctx.substeps } {
-        integrate_velocities(ctx, sims, states);
+        let carried = carries && i > 0;
+        integrate_velocities(ctx, sims, states, carried.then_some(carry));
         t[0] += lap.lap();
         // Always called: it also records approach speeds (impulses are zero when warm
         // starting is off).
-        constraints.warm_start(ctx, states);
+        constraints.warm_start(ctx, states, carried);
         t[1] += lap.lap();
         let elapsed = i as f32 * ctx.h;
-        constraints.solve(ctx, states, true, elapsed);
+        constraints.solve(ctx, states, true, elapsed, None);
         t[2] += lap.lap();
         integrate_positions(ctx, sims, states);
         t[3] += lap.lap();
-        constraints.solve(ctx, states, false, elapsed + ctx.h);
+        let into = (carries && i + 1 < ctx.substeps).then_some(carry);
+        constraints.solve(ctx, states, false, elapsed + ctx.h, into);
         constraints.end_substep();
         t[4] += lap.lap();
     }
@@ -1161,26 +1235,42 @@ pub(crate) fn loads(s: &BodySim) -> bool {
 /// Bodies per parallel chunk of the integration stages.
 const BODY_CHUNK: usize = 512;
 
-/// v ← (v + h·a) / (1 + h·c): explicit forces, Padé damping (Box2D v3).
-fn integrate_velocities<S: StateCell>(ctx: &StepContext, sims: &[BodySim], states: &[S]) {
+/// v ← (v + h·a) / (1 + h·c): explicit forces, Padé damping (Box2D v3); then, with
+/// `carry`, the warm start carried from the last relax pass (see [`solve_step`]).
+fn integrate_velocities<S: StateCell>(ctx: &StepContext, sims: &[BodySim], states: &[S], carry: Option<&[S]>) {
     let h = ctx.h;
     // Index 0 is the shared static body: it never moves.
-    S::for_each_index(states, sims.len(), BODY_CHUNK, |k, states| {
-        if k == 0 {
-            return;
-        }
-        integrate_velocity_one(h, &sims[k], &states[k]);
-    });
+    S::for_each_index(
+        states,
+        carry.unwrap_or(&[]),
+        sims.len(),
+        BODY_CHUNK,
+        |k, states, carry| {
+            if k == 0 {
+                return;
+            }
+            if let (Some(sim), Some(state)) = (sims.get(k), states.get(k)) {
+                integrate_velocity_one(h, sim, state, carry.get(k));
+            }
+        },
+    );
 }
 
-/// [`integrate_velocities`] for one body.
+/// [`integrate_velocities`] for one body: with `carry`, the velocity carried from the
+/// last relax pass is added and the carry cleared.
 #[inline]
-pub(crate) fn integrate_velocity_one<S: StateCell>(h: f32, sim: &BodySim, state: &S) {
+pub(crate) fn integrate_velocity_one<S: StateCell>(h: f32, sim: &BodySim, state: &S, carry: Option<&S>) {
     let s = state.get();
     let lin = 1.0 / (1.0 + h * sim.linear_damping);
     let ang = 1.0 / (1.0 + h * sim.angular_damping);
-    let v = (s.v + h * sim.linear_accel) * lin;
-    let w = (s.w + h * sim.angular_accel) * ang;
+    let mut v = (s.v + h * sim.linear_accel) * lin;
+    let mut w = (s.w + h * sim.angular_accel) * ang;
+    if let Some(c) = carry {
+        let k = c.get();
+        v += k.v;
+        w += k.w;
+        c.set_velocity(Vec2::ZERO, 0.0, 0.0);
+    }
     state.set_velocity(v, w, 0.0);
 }
 
@@ -1195,9 +1285,10 @@ fn integrate_positions<S: StateCell>(ctx: &StepContext, sims: &[BodySim], states
     let n = sims.len();
     S::for_each_index(
         states,
+        &[],
         n.div_ceil(wide::LANES4),
         BODY_CHUNK / wide::LANES4,
-        |q, states| {
+        |q, states, _| {
             let first = q * wide::LANES4;
             integrate_positions_range(ctx, sims, states, first.max(1)..(first + wide::LANES4).min(n));
         },

@@ -225,6 +225,9 @@ pub struct World {
     pub(crate) non_finite: Vec<BodyId>,
     // Scratch buffers reused every step (no per-step allocation once warm).
     pub(crate) states: Vec<BodyState>,
+    /// The warm start each relax pass carries to the next substep, one entry per state
+    /// (velocities only; all zero between steps, see `solver::solve_step`).
+    pub(crate) carry: Vec<BodyState>,
     pub(crate) sims: Vec<BodySim>,
     pub(crate) contact_solver: Contacts,
     pub(crate) joint_solver: crate::solver::joint_solver::JointSolver,
@@ -354,6 +357,7 @@ impl World {
             island_free: Vec::new(),
             non_finite: Vec::new(),
             states: Vec::new(),
+            carry: Vec::new(),
             sims: Vec::new(),
             contact_solver: Contacts::new(def.solver_lanes),
             joint_solver: Default::default(),

@@ -987,15 +987,21 @@ impl World {
         // Either way the results are the same to the bit.
         let (groups, colours) = set.contacts.layout_size();
         let threads = rayon::current_num_threads();
+        // All zero between steps (each substep's velocity pass clears what the relax before
+        // it carried, and the last relax carries nothing); only its length follows the states.
+        debug_assert!(self.carry.iter().all(|c| c.v == Vec2::ZERO && c.w == 0.0));
+        self.carry.resize(self.states.len(), BodyState::default());
         if ctx.parallel
             && (groups >= TEAM_MIN_GROUPS_PER_THREAD * threads * colours || set.joints.worth_sharing(threads))
         {
             // Threads share the states in place (`SharedState`, 32 bytes each).
             let shared = SharedState::from_mut_slice(&mut self.states);
-            solve_step(ctx, &self.sims, shared, &mut set, &mut self.profile);
+            let carry = SharedState::from_mut_slice(&mut self.carry);
+            solve_step(ctx, &self.sims, shared, carry, &mut set, &mut self.profile);
         } else {
             let cells = core::cell::Cell::from_mut(&mut self.states[..]).as_slice_of_cells();
-            solve_step(ctx, &self.sims, cells, &mut set, &mut self.profile);
+            let carry = core::cell::Cell::from_mut(&mut self.carry[..]).as_slice_of_cells();
+            solve_step(ctx, &self.sims, cells, carry, &mut set, &mut self.profile);
         }
         lap.lap();
         solver.store_step(ctx, &self.states, &mut self.contacts, &mut self.contact_sums);
