@@ -1113,11 +1113,30 @@ impl ContactSolver {
 
     /// [`ConstraintSet::estimate_new_contacts`].
     #[super::lane_fn]
-    fn estimate_new<S: StateCell>(&mut self, ctx: &StepContext, trial: &[S]) -> bool {
+    fn estimate_new<S: StateCell, T: StateCell>(
+        &mut self,
+        ctx: &StepContext,
+        sims: &[BodySim],
+        states: &[S],
+        trial: &[T],
+    ) -> bool {
         let mut subset = Vec::new();
         let mut slots = Vec::new();
+        // The trial states of the new constraints' bodies: each one's state after one
+        // substep of forces (`integrate_velocity_one`, made again for a body met twice;
+        // the static body's as it is). The estimate reads and writes no other body.
+        let make = |k: u32| {
+            if let (Some(t), Some(s)) = (trial.get(k as usize), states.get(k as usize)) {
+                t.set(s.get());
+                if let (true, Some(sim)) = (k != 0, sims.get(k as usize)) {
+                    integrate_velocity_one(ctx.h, sim, t, None);
+                }
+            }
+        };
         for &slot in &self.fresh {
             let mut cc = self.get(slot);
+            make(cc.index_a);
+            make(cc.index_b);
             record_approach(&mut cc, trial);
             if is_new_resting(&cc) {
                 subset.push(cc);
@@ -1276,9 +1295,15 @@ impl ConstraintSet for ContactSolver {
         self.loaded && !self.fresh.is_empty()
     }
 
-    fn estimate_new_contacts<S: StateCell>(&mut self, ctx: &StepContext, trial: &[S]) -> bool {
+    fn estimate_new_contacts<S: StateCell, T: StateCell>(
+        &mut self,
+        ctx: &StepContext,
+        sims: &[BodySim],
+        states: &[S],
+        trial: &[T],
+    ) -> bool {
         // SAFETY: see the impl.
-        unsafe { self.estimate_new(ctx, trial) }
+        unsafe { self.estimate_new(ctx, sims, states, trial) }
     }
 
     fn warm_start<S: StateCell>(&mut self, _ctx: &StepContext, states: &[S], carried: bool) {

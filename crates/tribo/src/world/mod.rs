@@ -228,6 +228,8 @@ pub struct World {
     /// The warm start each relax pass carries to the next substep, one entry per state
     /// (velocities only; all zero between steps, see `solver::solve_step`).
     pub(crate) carry: Vec<BodyState>,
+    /// Scratch states of the warm-start estimate of new contacts (see `solver::solve_step`).
+    pub(crate) trial: Vec<BodyState>,
     pub(crate) sims: Vec<BodySim>,
     pub(crate) contact_solver: Contacts,
     pub(crate) joint_solver: crate::solver::joint_solver::JointSolver,
@@ -358,6 +360,7 @@ impl World {
             non_finite: Vec::new(),
             states: Vec::new(),
             carry: Vec::new(),
+            trial: Vec::new(),
             sims: Vec::new(),
             contact_solver: Contacts::new(def.solver_lanes),
             joint_solver: Default::default(),

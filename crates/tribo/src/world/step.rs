@@ -997,11 +997,27 @@ impl World {
             // Threads share the states in place (`SharedState`, 32 bytes each).
             let shared = SharedState::from_mut_slice(&mut self.states);
             let carry = SharedState::from_mut_slice(&mut self.carry);
-            solve_step(ctx, &self.sims, shared, carry, &mut set, &mut self.profile);
+            solve_step(
+                ctx,
+                &self.sims,
+                shared,
+                carry,
+                &mut self.trial,
+                &mut set,
+                &mut self.profile,
+            );
         } else {
             let cells = core::cell::Cell::from_mut(&mut self.states[..]).as_slice_of_cells();
             let carry = core::cell::Cell::from_mut(&mut self.carry[..]).as_slice_of_cells();
-            solve_step(ctx, &self.sims, cells, carry, &mut set, &mut self.profile);
+            solve_step(
+                ctx,
+                &self.sims,
+                cells,
+                carry,
+                &mut self.trial,
+                &mut set,
+                &mut self.profile,
+            );
         }
         lap.lap();
         solver.store_step(ctx, &self.states, &mut self.contacts, &mut self.contact_sums);
