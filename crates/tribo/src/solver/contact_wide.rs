@@ -820,6 +820,10 @@ fn normal_rows<const USE_BIAS: bool, const POINTS: usize>(
 /// form (the relative velocity dotted with the row, the impulse vector crossed with each
 /// arm) needed more operations and more registers than SSE's sixteen hold: large_pyramid
 /// ran 4 % fewer instructions, and its solve and relax took 8 % and 10 % less time.
+///
+/// With `carry` (a relax pass, `USE_BIAS` false; ignored in the biased pass), the group's
+/// next warm start is added to its bodies' carry entries ([`carry_warm_start`]); `carry`
+/// must have an entry for every state the lanes index.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(crate) fn solve<const USE_BIAS: bool, S: StateCell>(
@@ -2273,69 +2277,92 @@ mod tests {
 
     /// The relax pass's carry is the next warm start (`carry_warm_start`, see
     /// `solver::solve_step`): after a relax pass that carries, each body's carry entry
-    /// must equal what [`warm_start`] then adds to its relaxed velocity, for two-point,
-    /// one-point (against the ground) and rolling lanes whose bodies moved and turned
-    /// since the step start (shifted arms). The same impulses on the same arms, summed in
-    /// another order (moments of the rows instead of cross products of the arms), so equal
-    /// to 1e-5 of the largest change: a wrong arm, sign or missing row is off by far more.
+    /// must equal what [`warm_start`] then adds to its relaxed velocity. Three groups:
+    /// two-point, one-point (against the ground) and rolling lanes whose bodies moved and
+    /// turned since the step start (shifted arms); one-point lanes only (the rows' one-point
+    /// form); and bodies moved apart along the tangent past the shift's cap. The same
+    /// impulses on the same arms, summed in another order (moments of the rows instead of
+    /// cross products of the arms), so equal to 1e-5 of the largest change: a wrong arm,
+    /// sign or missing row is off by far more.
     #[test]
     fn relax_carries_the_next_warm_start() {
         let f = fixture();
-        // Lanes of one colour (no dynamic body in two), slow bodies that moved and turned.
-        let cases = [
+        let mixed = [
             (7u32, input(2, false, 0.0, 0.0), bodies(1, 2)),
             (9, input(1, false, 0.0, 0.0), bodies(0, 3)),
             (12, input(2, false, 0.0, 0.05), bodies(4, 5)),
         ];
-        let moved: Vec<BodyState> = (0..6)
-            .map(|k| BodyState {
-                v: Vec2::new(0.004 * k as f32, -0.003),
-                w: 0.01 * k as f32,
-                touched: 0.0,
-                dp: Vec2::new(1e-3 * k as f32, -2e-3 * k as f32),
-                dq: Rot::from_angle(2e-3 * k as f32),
-            })
-            .collect();
-        let (mut h, arms, mut rare, mut w, _, dv) = built(lanes_of(&cases), f.up, &f.ctx, &moved);
+        let single = [
+            (7u32, input(1, false, 0.0, 0.0), bodies(1, 2)),
+            (9, input(1, false, 0.0, 0.0), bodies(0, 3)),
+        ];
+        // Slow bodies (the impulses stay on) that moved and turned a little; the third
+        // variant moves each body 0.3 m further along the tangent per index, past the cap.
+        let tangent = Vec2::new(0.8, -0.6);
+        let moved = |far: bool| -> Vec<BodyState> {
+            (0..6)
+                .map(|k| BodyState {
+                    v: Vec2::new(0.004 * k as f32, -0.003),
+                    w: 0.01 * k as f32,
+                    touched: 0.0,
+                    dp: Vec2::new(1e-3 * k as f32, -2e-3 * k as f32) + tangent * if far { 0.3 * k as f32 } else { 0.0 },
+                    dq: Rot::from_angle(2e-3 * k as f32),
+                })
+                .collect()
+        };
         let cells = |s: &[BodyState]| -> Vec<core::cell::Cell<BodyState>> {
             s.iter().map(|&s| core::cell::Cell::new(s)).collect()
         };
-        let (states, carry) = (cells(&moved), cells(&vec![BodyState::default(); moved.len()]));
-        solve::<false, _>(
-            &mut h,
-            &mut rare,
-            &mut w,
-            &dv,
-            &states,
-            &f.ctx,
-            &f.soft,
-            f.ctx.h,
-            Some(&carry),
-        );
-        let relaxed: Vec<BodyState> = states.iter().map(|c| c.get()).collect();
-        warm_start(&h, &arms, &mut rare, &states);
-        let changes: Vec<(Vec2, f32)> = states
-            .iter()
-            .zip(&relaxed)
-            .map(|(s, r)| (s.get().v - r.v, s.get().w - r.w))
-            .collect();
-        let largest = changes.iter().fold(0.0f32, |m, (v, w)| m.max(v.length()).max(w.abs()));
-        assert!(largest > 0.1, "the warm start changes the velocities ({largest})");
-        assert!(
-            h.any_rolling && h.two_points.any(),
-            "the fixture has rolling and two-point lanes"
-        );
-        for (k, ((v, w), c)) in changes.iter().zip(&carry).enumerate() {
-            let c = c.get();
-            let off = (c.v - *v).length().max((c.w - w).abs());
-            assert!(
-                off <= 1e-5 * largest,
-                "body {k}: carry {:?} {} vs warm start {v:?} {w}",
-                c.v,
-                c.w
+        for (name, cases, far) in [
+            ("mixed", &mixed[..], false),
+            ("one-point", &single[..], false),
+            ("capped", &mixed[..], true),
+        ] {
+            let start = moved(far);
+            let (mut h, arms, mut rare, mut w, _, dv) = built(lanes_of(cases), f.up, &f.ctx, &start);
+            let d = start[2].dp - start[1].dp;
+            assert_eq!(
+                far,
+                d.length_squared() > h.shift_cap2[0],
+                "{name}: lane 0's shift capped"
             );
+            assert_eq!(name != "one-point", h.two_points.any(), "{name}: two-point lanes");
+            let (states, carry) = (cells(&start), cells(&vec![BodyState::default(); start.len()]));
+            solve::<false, _>(
+                &mut h,
+                &mut rare,
+                &mut w,
+                &dv,
+                &states,
+                &f.ctx,
+                &f.soft,
+                f.ctx.h,
+                Some(&carry),
+            );
+            let relaxed: Vec<BodyState> = states.iter().map(|c| c.get()).collect();
+            warm_start(&h, &arms, &mut rare, &states);
+            let changes: Vec<(Vec2, f32)> = states
+                .iter()
+                .zip(&relaxed)
+                .map(|(s, r)| (s.get().v - r.v, s.get().w - r.w))
+                .collect();
+            let largest = changes.iter().fold(0.0f32, |m, (v, w)| m.max(v.length()).max(w.abs()));
+            assert!(
+                largest > 0.1,
+                "{name}: the warm start changes the velocities ({largest})"
+            );
+            for (k, ((v, w), c)) in changes.iter().zip(&carry).enumerate() {
+                let c = c.get();
+                let off = (c.v - *v).length().max((c.w - w).abs());
+                assert!(
+                    off <= 1e-5 * largest,
+                    "{name}, body {k}: carry {:?} {} vs warm start {v:?} {w}",
+                    c.v,
+                    c.w
+                );
+            }
+            assert_eq!(carry[0].get().v, Vec2::ZERO, "{name}: the ground takes no carry");
         }
-        assert_eq!(carry[0].get().v, Vec2::ZERO, "the ground takes no carry");
     }
 
     /// The store's wide half must write into each contact exactly what the scalar store

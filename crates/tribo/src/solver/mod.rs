@@ -112,7 +112,8 @@ unsafe impl Sync for SharedState {}
 /// implementation per step mode, so a single-threaded step works on plain states
 /// ([`Cell`]s over the world's `BodyState`s, no atomics; also a threaded step whose layout
 /// is too small to share, see `World::solve_with`) and a multi-threaded one on
-/// [`SharedState`]s (relaxed atomics, work split between the pool's threads). The solver
+/// [`SharedState`]s (plain memory under the contract in its doc, work split between the
+/// pool's threads). The solver
 /// code is generic over it: the physics is written once.
 pub(crate) trait StateRead {
     fn get(&self) -> BodyState;

@@ -989,8 +989,12 @@ impl World {
         let threads = rayon::current_num_threads();
         // All zero between steps (each substep's velocity pass clears what the relax before
         // it carried, and the last relax carries nothing); only its length follows the states.
+        if self.carry_in_use {
+            self.carry.fill(BodyState::default());
+        }
         debug_assert!(self.carry.iter().all(|c| c.v == Vec2::ZERO && c.w == 0.0));
         self.carry.resize(self.states.len(), BodyState::default());
+        self.carry_in_use = true;
         if ctx.parallel
             && (groups >= TEAM_MIN_GROUPS_PER_THREAD * threads * colours || set.joints.worth_sharing(threads))
         {
@@ -1019,6 +1023,7 @@ impl World {
                 &mut self.profile,
             );
         }
+        self.carry_in_use = false;
         lap.lap();
         solver.store_step(ctx, &self.states, &mut self.contacts, &mut self.contact_sums);
         // The touching contacts the solver did not take report nothing applied.
