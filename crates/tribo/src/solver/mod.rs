@@ -1192,8 +1192,8 @@ pub(crate) fn solve_step<S: StateCell, C: ConstraintSet>(
     // body sag and slide before the load builds up (the settling creep of Box2D and
     // Rapier). Estimate its impulses first on scratch states (`trial`, kept between
     // steps: only the new constraints' bodies are made and read, not a copy of every
-    // state, which cost a pile in motion with a few new contacts a step, the tumbler, 2 %
-    // of its step).
+    // state made and integrated, which cost the tumbler, a pile in motion with ~140 new
+    // contacts a step, 6 µs of its 1.45 ms).
     if constraints.has_new_contacts() {
         trial.resize(states.len(), BodyState::default());
         let trial = core::cell::Cell::from_mut(&mut trial[..]).as_slice_of_cells();
